@@ -1,0 +1,45 @@
+"""lindstedt: exact Lindstedt–Poincaré (strained coordinates) expansions of weakly nonlinear oscillators.
+
+The public API is re-exported here; everything else is private.
+
+Examples
+--------
+>>> import lindstedt
+>>> lindstedt.expand("u**3", order=2, a0=1, omega0=1).omega
+(1, 3/8, -21/256)
+"""
+
+from ._api import expand
+from ._cosine import CosineSeries, SineSeries, solve_harmonic_oscillator
+from ._errors import (
+    ConvergenceError,
+    LindstedtError,
+    OrderError,
+    ParameterError,
+    ProblemError,
+    ResonanceError,
+    UnsupportedNonlinearityError,
+)
+from ._expansion import Expansion, Waveform
+from ._hierarchy import LindstedtPoincare
+from ._problem import Oscillator
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "expand",
+    "Oscillator",
+    "LindstedtPoincare",
+    "Expansion",
+    "Waveform",
+    "CosineSeries",
+    "SineSeries",
+    "solve_harmonic_oscillator",
+    "LindstedtError",
+    "ProblemError",
+    "ParameterError",
+    "UnsupportedNonlinearityError",
+    "OrderError",
+    "ResonanceError",
+    "ConvergenceError",
+]

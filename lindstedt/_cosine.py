@@ -1,0 +1,350 @@
+"""Exact algebra of even 2π-periodic cosine polynomials.
+
+The objects are finite sums ``v(s) = Σ_n c_n cos(n s)`` (``CosineSeries``) and
+their derivatives ``Σ_n c_n sin(n s)`` (``SineSeries``), with coefficients in a
+sympy *domain* (``QQ``, a polynomial ring ``QQ[r1, ...]``, or a
+``RealField`` of a chosen precision).  Products use the product-to-sum rule
+
+    cos(m s) cos(n s) = ½ [cos((m + n) s) + cos(|m − n| s)],
+
+and the one differential equation the Lindstedt–Poincaré hierarchy needs is
+solved in closed form:
+
+    α0 (v'' + v) = r(s),   r even, 2π-periodic, with zero cos(s) coefficient,
+
+whose even periodic solutions are ``v = Σ_{n≠1} r_n / (α0 (1 − n²)) cos(n s)
++ C cos(s)`` with ``C`` fixed by a normalisation (``v(0)`` given, or zero
+first-harmonic coefficient).  No ``dsolve`` and no ``simplify`` are used: all
+work is domain arithmetic on dictionaries, which is where the speed comes from.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Iterable, Mapping
+
+import numpy as np
+import sympy
+from sympy import Rational
+
+from ._errors import LindstedtError
+
+__all__ = ["CosineSeries", "SineSeries", "solve_harmonic_oscillator"]
+
+DomainElement = Any
+
+
+class _TrigonometricSeries:
+    """Shared machinery of cosine and sine series (dictionary of harmonics)."""
+
+    __slots__ = ("domain", "_coefficients")
+    _basis: Callable[[Any], Any]
+    _numpy_basis: Callable[[np.ndarray], np.ndarray]
+
+    def __init__(self, domain: Any, coefficients: Mapping[int, DomainElement] | None = None):
+        self.domain = domain
+        cleaned: dict[int, DomainElement] = {}
+        for harmonic, value in (coefficients or {}).items():
+            if harmonic < 0:
+                raise ValueError(f"harmonic index must be >= 0, got {harmonic}")
+            if value:
+                cleaned[int(harmonic)] = value
+        self._coefficients = cleaned
+
+    # -- read access -------------------------------------------------------------
+    @property
+    def coefficients(self) -> dict[int, DomainElement]:
+        """A copy of the nonzero coefficients, keyed by harmonic number."""
+        return dict(self._coefficients)
+
+    def coefficient(self, harmonic: int) -> DomainElement:
+        """Coefficient of harmonic ``harmonic`` (the domain's zero if absent)."""
+        return self._coefficients.get(harmonic, self.domain.zero)
+
+    @property
+    def harmonics(self) -> list[int]:
+        """Sorted harmonic numbers with a nonzero coefficient."""
+        return sorted(self._coefficients)
+
+    @property
+    def degree(self) -> int:
+        """Highest harmonic present (−1 for the zero series)."""
+        return max(self._coefficients, default=-1)
+
+    def is_zero(self) -> bool:
+        """True when every coefficient vanishes."""
+        return not self._coefficients
+
+    def __len__(self) -> int:
+        return len(self._coefficients)
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not type(self):
+            return NotImplemented
+        return self._coefficients == other._coefficients  # type: ignore[attr-defined]
+
+    def __hash__(self) -> int:
+        return hash((type(self).__name__, tuple(sorted(self._coefficients.items(), key=lambda kv: kv[0]))))
+
+    # -- linear structure ----------------------------------------------------------
+    def _new(self, coefficients: Mapping[int, DomainElement]):
+        return type(self)(self.domain, coefficients)
+
+    def __add__(self, other):
+        if type(other) is not type(self):
+            return NotImplemented
+        result = dict(self._coefficients)
+        for harmonic, value in other._coefficients.items():
+            result[harmonic] = result.get(harmonic, self.domain.zero) + value
+        return self._new(result)
+
+    def __sub__(self, other):
+        if type(other) is not type(self):
+            return NotImplemented
+        return self + (-other)
+
+    def __neg__(self):
+        return self._new({n: -c for n, c in self._coefficients.items()})
+
+    def scale(self, factor: DomainElement):
+        """Multiply every coefficient by the domain element ``factor``."""
+        if not factor:
+            return self._new({})
+        return self._new({n: c * factor for n, c in self._coefficients.items()})
+
+    def map_coefficients(self, function: Callable[[int, DomainElement], DomainElement]):
+        """New series with coefficient ``function(n, c_n)`` for each harmonic ``n``."""
+        return self._new({n: function(n, c) for n, c in self._coefficients.items()})
+
+    def pruned(self, tolerance: float):
+        """Drop coefficients whose magnitude is below ``tolerance`` (float domains)."""
+        return self._new({n: c for n, c in self._coefficients.items() if abs(c) > tolerance})
+
+    # -- conversion and evaluation ---------------------------------------------------
+    def to_expr(self, variable: sympy.Symbol, to_sympy: Callable[[DomainElement], sympy.Expr] | None = None) -> sympy.Expr:
+        """The series as a sympy expression in ``variable``."""
+        convert = to_sympy or self.domain.to_sympy
+        return sympy.Add(*[convert(c) * type(self)._basis(n * variable) for n, c in sorted(self._coefficients.items())])
+
+    def float_coefficients(self, to_float: Callable[[DomainElement], float] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Arrays ``(harmonics, coefficients)`` in float64 for fast evaluation."""
+        convert = to_float or (lambda c: float(self.domain.to_sympy(c)))
+        items = sorted(self._coefficients.items())
+        harmonics = np.array([n for n, _ in items], dtype=float)
+        values = np.array([convert(c) for _, c in items], dtype=float)
+        return harmonics, values
+
+    def evaluate_float(self, s: Any, to_float: Callable[[DomainElement], float] | None = None) -> np.ndarray:
+        """Evaluate at float ``s`` (scalar or array), vectorised with numpy."""
+        harmonics, values = self.float_coefficients(to_float)
+        points = np.asarray(s, dtype=float)
+        if harmonics.size == 0:
+            return np.zeros_like(points)
+        return np.tensordot(type(self)._numpy_basis(np.multiply.outer(points, harmonics)), values, axes=([-1], [0]))
+
+
+class CosineSeries(_TrigonometricSeries):
+    """Even cosine polynomial ``Σ_n c_n cos(n s)`` with coefficients in a sympy domain.
+
+    Parameters
+    ----------
+    domain : sympy domain
+        Where the coefficients live (``QQ``, ``QQ[r]``, ``RealField(...)``).
+    coefficients : mapping int -> domain element
+        Coefficient of ``cos(n s)`` for harmonic ``n >= 0``; zeros are dropped.
+
+    Examples
+    --------
+    >>> from sympy import QQ
+    >>> c = CosineSeries.cosine(QQ)
+    >>> (c ** 3).coefficients == {1: QQ(3, 4), 3: QQ(1, 4)}
+    True
+    """
+
+    __slots__ = ()
+    _basis = staticmethod(sympy.cos)
+    _numpy_basis = staticmethod(np.cos)
+
+    @classmethod
+    def constant(cls, domain: Any, value: DomainElement) -> "CosineSeries":
+        """The constant function ``value``."""
+        return cls(domain, {0: value})
+
+    @classmethod
+    def cosine(cls, domain: Any, harmonic: int = 1, amplitude: DomainElement | None = None) -> "CosineSeries":
+        """``amplitude · cos(harmonic · s)`` (amplitude defaults to one)."""
+        return cls(domain, {harmonic: domain.one if amplitude is None else amplitude})
+
+    def __mul__(self, other):
+        if isinstance(other, CosineSeries):
+            return self._product(other)
+        if isinstance(other, _TrigonometricSeries):
+            return NotImplemented
+        return self.scale(other)
+
+    __rmul__ = __mul__
+
+    def _product(self, other: "CosineSeries") -> "CosineSeries":
+        half = self.domain.convert(Rational(1, 2))
+        accumulated: dict[int, DomainElement] = {}
+        zero = self.domain.zero
+        for m, a in self._coefficients.items():
+            for n, b in other._coefficients.items():
+                product = a * b
+                total = m + n
+                accumulated[total] = accumulated.get(total, zero) + product
+                difference = m - n if m >= n else n - m
+                accumulated[difference] = accumulated.get(difference, zero) + product
+        return CosineSeries(self.domain, {n: c * half for n, c in accumulated.items()})
+
+    def product_coefficient(self, other: "CosineSeries", harmonic: int) -> DomainElement:
+        """Coefficient of ``cos(harmonic s)`` in ``self * other`` without forming the product.
+
+        This is what makes the frequency correction of the next order cheap:
+        only the secular (``harmonic = 1``) coefficient is needed.
+        """
+        zero = self.domain.zero
+        total = zero
+        other_coefficients = other._coefficients
+        for m, a in self._coefficients.items():
+            for n in {harmonic - m, m - harmonic, m + harmonic}:
+                if n < 0 or n not in other_coefficients:
+                    continue
+                b = other_coefficients[n]
+                # cos(m s) cos(n s) contributes ½ to harmonic m+n and ½ to |m-n|.
+                weight = (1 if m + n == harmonic else 0) + (1 if abs(m - n) == harmonic else 0)
+                if weight:
+                    total = total + a * b * weight
+        return total * self.domain.convert(Rational(1, 2))
+
+    def __pow__(self, exponent: int) -> "CosineSeries":
+        if not isinstance(exponent, int) or exponent < 0:
+            raise ValueError("CosineSeries powers must be non-negative integers")
+        result = CosineSeries.constant(self.domain, self.domain.one)
+        base = self
+        while exponent:
+            if exponent & 1:
+                result = result * base
+            exponent >>= 1
+            if exponent:
+                base = base * base
+        return result
+
+    def second_derivative(self) -> "CosineSeries":
+        """``d²/ds²``: multiplies ``c_n`` by ``−n²``."""
+        return self._new({n: c * self.domain.convert(-n * n) for n, c in self._coefficients.items()})
+
+    def derivative(self) -> "SineSeries":
+        """``d/ds Σ c_n cos(ns) = Σ (−n c_n) sin(ns)``."""
+        return SineSeries(self.domain, {n: c * self.domain.convert(-n) for n, c in self._coefficients.items() if n})
+
+    def value_at_zero(self) -> DomainElement:
+        """``v(0) = Σ c_n`` exactly."""
+        total = self.domain.zero
+        for c in self._coefficients.values():
+            total = total + c
+        return total
+
+    def convert_domain(self, domain: Any, converter: Callable[[DomainElement], DomainElement]) -> "CosineSeries":
+        """The same series with coefficients mapped into another domain."""
+        return CosineSeries(domain, {n: converter(c) for n, c in self._coefficients.items()})
+
+    def __repr__(self) -> str:
+        terms = " + ".join(f"({c})*cos({n}s)" for n, c in sorted(self._coefficients.items()))
+        return f"CosineSeries({terms or '0'})"
+
+
+class SineSeries(_TrigonometricSeries):
+    """Odd sine polynomial ``Σ_n c_n sin(n s)`` (derivatives of cosine series).
+
+    Examples
+    --------
+    >>> from sympy import QQ
+    >>> CosineSeries.cosine(QQ, 2).derivative().coefficients == {2: QQ(-2)}
+    True
+    """
+
+    __slots__ = ()
+    _basis = staticmethod(sympy.sin)
+    _numpy_basis = staticmethod(np.sin)
+
+    def derivative(self) -> CosineSeries:
+        """``d/ds Σ c_n sin(ns) = Σ n c_n cos(ns)``."""
+        return CosineSeries(self.domain, {n: c * self.domain.convert(n) for n, c in self._coefficients.items()})
+
+    def __repr__(self) -> str:
+        terms = " + ".join(f"({c})*sin({n}s)" for n, c in sorted(self._coefficients.items()))
+        return f"SineSeries({terms or '0'})"
+
+
+class SecularTermError(LindstedtError):
+    """The right-hand side of the periodic solve still contains a cos(s) term."""
+
+
+def solve_harmonic_oscillator(
+    right_hand_side: CosineSeries,
+    alpha0: DomainElement,
+    *,
+    value_at_zero: DomainElement | None = None,
+    first_harmonic: DomainElement | None = None,
+) -> CosineSeries:
+    """Even 2π-periodic solution of ``α0 (v'' + v) = rhs``.
+
+    Parameters
+    ----------
+    right_hand_side : CosineSeries
+        Must have a zero ``cos(s)`` coefficient (no secular term).
+    alpha0 : domain element
+        The nonzero factor ``α0 = ω0²``.
+    value_at_zero, first_harmonic : domain element, exactly one of them
+        Fix the free homogeneous part ``C cos(s)``: either ``v(0)`` equals
+        ``value_at_zero`` ("initial" normalisation) or the ``cos(s)``
+        coefficient of ``v`` equals ``first_harmonic`` ("harmonic" one).
+
+    Returns
+    -------
+    CosineSeries
+        ``v = Σ_{n≠1} rhs_n / (α0 (1 − n²)) cos(ns) + C cos(s)``.
+
+    Raises
+    ------
+    SecularTermError
+        If the right-hand side has a nonzero ``cos(s)`` coefficient.
+
+    Examples
+    --------
+    >>> from sympy import QQ
+    >>> rhs = CosineSeries.cosine(QQ, 3)
+    >>> v = solve_harmonic_oscillator(rhs, QQ(1), value_at_zero=QQ(0))
+    >>> v.coefficients == {3: QQ(-1, 8), 1: QQ(1, 8)}
+    True
+    """
+    if (value_at_zero is None) == (first_harmonic is None):
+        raise ValueError("give exactly one of value_at_zero and first_harmonic")
+    domain = right_hand_side.domain
+    if right_hand_side.coefficient(1):
+        raise SecularTermError(
+            "the right-hand side has a secular cos(s) coefficient "
+            f"{right_hand_side.coefficient(1)}; choose the frequency correction that removes it"
+        )
+    inverse_alpha0 = domain.one / alpha0 if alpha0 != domain.one else domain.one
+    particular: dict[int, DomainElement] = {}
+    for harmonic, value in right_hand_side._coefficients.items():
+        particular[harmonic] = value * inverse_alpha0 * domain.convert(Rational(1, 1 - harmonic * harmonic))
+    if first_harmonic is not None:
+        particular[1] = first_harmonic
+    else:
+        total = domain.zero
+        for value in particular.values():
+            total = total + value
+        particular[1] = value_at_zero - total
+    return CosineSeries(domain, particular)
+
+
+def sum_series(terms: Iterable[CosineSeries], domain: Any) -> CosineSeries:
+    """Sum of cosine series (the zero series for an empty iterable)."""
+    accumulated: dict[int, DomainElement] = {}
+    zero = domain.zero
+    for term in terms:
+        for harmonic, value in term._coefficients.items():
+            accumulated[harmonic] = accumulated.get(harmonic, zero) + value
+    return CosineSeries(domain, accumulated)

@@ -1,0 +1,333 @@
+"""Results of the Lindstedt–Poincaré expansion of ``u'' + ω0² u + ε f(u) = 0``.
+
+An :class:`Expansion` of order N holds, lazily and exactly,
+
+* ``omega`` = (ω_0, …, ω_N): ``ω(ε) = Σ_k ω_k ε^k``;
+* ``alpha`` = (α_0, …, α_N): ``ω(ε)² = Σ_k α_k ε^k``;
+* ``waveforms`` = (v_0, …, v_N): ``u(t) = Σ_k ε^k v_k(ω t)``, each an exact
+  even cosine polynomial :class:`Waveform`.
+
+The numeric evaluator :meth:`Expansion.displacement` pairs the waveforms
+v_0 … v_N with the frequency through ω_{N+1} (computed on demand, it needs only
+the secular part of the next forcing): that is the consistent truncation whose
+error is O(ε^{N+1}) uniformly for t ≤ C/ε.
+
+JSON schema ``lindstedt.expansion/1`` (:meth:`Expansion.to_dict`)::
+
+    {
+      "schema": "lindstedt.expansion/1",
+      "problem": {"equation": str, "f": str, "a0": str, "omega0": str,
+                  "parameters": {name: str}, "normalization": str},
+      "order": int, "normalization": "initial" | "harmonic",
+      "omega": [str, ...],            # ω_0..ω_N, sympy-parsable
+      "omega_float": [float | null],  # null where symbolic
+      "alpha": [str, ...], "alpha_float": [float | null],
+      "omega_next": str,              # ω_{N+1}, used by the displacement evaluator
+      "waveforms": [{"order": k, "cosine_coefficients": {"n": str}}]   # optional
+    }
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any, Callable, Mapping
+
+import numpy as np
+import sympy
+
+from ._errors import OrderError
+from ._hierarchy import MAX_ORDER, SmoothHierarchy
+from ._problem import Oscillator
+
+__all__ = ["Expansion", "Waveform", "STRAINED_TIME", "EPSILON", "TIME"]
+
+STRAINED_TIME = sympy.Symbol("s", real=True)
+EPSILON = sympy.Symbol("epsilon", real=True)
+TIME = sympy.Symbol("t", real=True)
+SCHEMA = "lindstedt.expansion/1"
+
+_LATEX_NAMES = {"a0": "a_{0}", "omega0": r"\omega_{0}", "epsilon": r"\varepsilon"}
+
+
+def _latex(expression: sympy.Expr) -> str:
+    names = {symbol: _LATEX_NAMES[symbol.name] for symbol in expression.free_symbols if symbol.name in _LATEX_NAMES}
+    return sympy.latex(expression, symbol_names=names)
+
+
+def _as_float(expression: sympy.Expr) -> float | None:
+    if expression.free_symbols:
+        return None
+    return float(expression)
+
+
+@dataclass(frozen=True)
+class Waveform:
+    """An exact even cosine polynomial ``v_k(s) = Σ_n c_n cos(n s)``.
+
+    Examples
+    --------
+    >>> import sympy
+    >>> w = Waveform(order=1, coefficients=((1, sympy.Rational(1, 32)), (3, sympy.Rational(-1, 32))))
+    >>> w.value_at_zero()
+    0
+    >>> w.to_expr()
+    cos(s)/32 - cos(3*s)/32
+    """
+
+    order: int
+    coefficients: tuple[tuple[int, sympy.Expr], ...]
+
+    @property
+    def harmonics(self) -> tuple[int, ...]:
+        """Harmonic numbers present, increasing."""
+        return tuple(harmonic for harmonic, _ in self.coefficients)
+
+    def coefficient(self, harmonic: int) -> sympy.Expr:
+        """Exact coefficient of ``cos(harmonic s)`` (zero when absent)."""
+        return dict(self.coefficients).get(harmonic, sympy.Integer(0))
+
+    def to_expr(self, variable: sympy.Symbol = STRAINED_TIME) -> sympy.Expr:
+        """The waveform as a sympy expression in ``variable``."""
+        return sympy.Add(*[value * sympy.cos(harmonic * variable) for harmonic, value in self.coefficients])
+
+    def value_at_zero(self) -> sympy.Expr:
+        """``v_k(0)`` exactly."""
+        return sympy.Add(*[value for _, value in self.coefficients])
+
+    def to_latex(self) -> str:
+        """LaTeX of the waveform through sympy's printer."""
+        return _latex(self.to_expr())
+
+
+@dataclass(frozen=True)
+class Expansion:
+    """Lindstedt–Poincaré expansion of an :class:`~lindstedt.Oscillator` to a given order.
+
+    Everything is computed on first access and cached; the object itself is
+    frozen and keeps a reference to its problem.
+
+    Examples
+    --------
+    >>> import lindstedt
+    >>> expansion = lindstedt.expand("u**3", order=2)
+    >>> expansion.omega[2]
+    -21*a0**4/(256*omega0**3)
+    >>> round(expansion.frequency(0.1, values={"a0": 1, "omega0": 1}), 12)
+    1.036679687500
+    """
+
+    problem: Oscillator
+    order: int
+    _hierarchy: SmoothHierarchy = field(repr=False, compare=False)
+
+    # -- exact quantities ---------------------------------------------------------------
+    @property
+    def _scale(self) -> sympy.Expr:
+        return self._hierarchy.form.epsilon_scale
+
+    def _to_expr(self, element: Any, power: int, prefactor: sympy.Expr) -> sympy.Expr:
+        value = self._hierarchy.form.to_expr(element)
+        expression = prefactor * self._scale**power * value
+        if self._hierarchy.form.generator_values:
+            expression = sympy.expand(expression)
+        return expression
+
+    def _check(self, order: int) -> None:
+        if isinstance(order, bool) or not isinstance(order, int) or order < 0 or order > MAX_ORDER + 1:
+            raise OrderError(f"correction index must be an integer in [0, {MAX_ORDER + 1}], got {order!r}")
+
+    def omega_correction(self, order: int) -> sympy.Expr:
+        """Exact ω_order (any order, computed lazily; beyond ``self.order`` allowed)."""
+        self._check(order)
+        return self._to_expr(self._hierarchy.frequency(order), order, self.problem.omega0)
+
+    def alpha_correction(self, order: int) -> sympy.Expr:
+        """Exact α_order, the ε^order coefficient of ω²."""
+        self._check(order)
+        return self._to_expr(self._hierarchy.squared_frequency(order), order, self.problem.omega0**2)
+
+    def waveform(self, order: int) -> Waveform:
+        """Exact v_order(s) as a :class:`Waveform`."""
+        self._check(order)
+        series = self._hierarchy.waveform(order)
+        coefficients = tuple(
+            (harmonic, self._to_expr(series.coefficient(harmonic), order, self.problem.a0)) for harmonic in series.harmonics
+        )
+        return Waveform(order=order, coefficients=coefficients)
+
+    @cached_property
+    def omega(self) -> tuple[sympy.Expr, ...]:
+        """(ω_0, …, ω_N), exact."""
+        return tuple(self.omega_correction(k) for k in range(self.order + 1))
+
+    @cached_property
+    def alpha(self) -> tuple[sympy.Expr, ...]:
+        """(α_0, …, α_N) with ω² = Σ α_k ε^k, exact."""
+        return tuple(self.alpha_correction(k) for k in range(self.order + 1))
+
+    @cached_property
+    def waveforms(self) -> tuple[Waveform, ...]:
+        """(v_0, …, v_N), exact cosine polynomials."""
+        return tuple(self.waveform(k) for k in range(self.order + 1))
+
+    @cached_property
+    def omega_next(self) -> sympy.Expr:
+        """ω_{N+1}: the frequency term the displacement evaluator pairs with v_0..v_N."""
+        return self.omega_correction(self.order + 1)
+
+    # -- numeric evaluation ---------------------------------------------------------------
+    def _substitution(self, values: Mapping[Any, Any] | None) -> dict[sympy.Symbol, sympy.Expr]:
+        return self.problem.numeric_substitution(values)
+
+    def _floats(self, expressions: list[sympy.Expr], values: Mapping[Any, Any] | None) -> np.ndarray:
+        substitution = self._substitution(values)
+        return np.array([float(sympy.sympify(e).xreplace(substitution)) for e in expressions], dtype=float)
+
+    def frequency(self, epsilon: Any, values: Mapping[Any, Any] | None = None, *, order: int | None = None) -> Any:
+        """ω(ε) = Σ_{k≤order} ω_k ε^k as float (vectorised over ``epsilon``).
+
+        Parameters
+        ----------
+        epsilon : float or array
+        values : mapping, optional
+            Numbers for the symbols left free (a0, omega0, parameters).
+        order : int, optional
+            Truncation order (default: the expansion's order).
+        """
+        order = self.order if order is None else order
+        coefficients = self._floats([self.omega_correction(k) for k in range(order + 1)], values)
+        result = np.polynomial.polynomial.polyval(np.asarray(epsilon, dtype=float), coefficients)
+        return float(result) if np.ndim(result) == 0 else result
+
+    def _combined_coefficients(self, epsilon: float, values: Mapping[Any, Any] | None) -> tuple[np.ndarray, np.ndarray, float]:
+        combined: dict[int, float] = {}
+        expressions: list[sympy.Expr] = []
+        keys: list[tuple[int, int]] = []
+        for waveform in self.waveforms:
+            for harmonic, value in waveform.coefficients:
+                expressions.append(value)
+                keys.append((waveform.order, harmonic))
+        numbers = self._floats(expressions, values)
+        for (order, harmonic), number in zip(keys, numbers):
+            combined[harmonic] = combined.get(harmonic, 0.0) + number * epsilon**order
+        omegas = self._floats(list(self.omega) + [self.omega_next], values)
+        frequency = float(np.polynomial.polynomial.polyval(epsilon, omegas))
+        harmonics = np.array(sorted(combined), dtype=float)
+        return harmonics, np.array([combined[int(h)] for h in harmonics]), frequency
+
+    def displacement(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None = None) -> np.ndarray:
+        """u(t) ≈ Σ_{k≤N} ε^k v_k(ω t), ω through ω_{N+1}; vectorised over ``t``.
+
+        Examples
+        --------
+        >>> import lindstedt, numpy as np
+        >>> e = lindstedt.expand("u**3", order=1, a0=1, omega0=1)
+        >>> float(e.displacement(0.0, 0.1))
+        1.0
+        """
+        harmonics, coefficients, frequency = self._combined_coefficients(float(epsilon), values)
+        phase = np.multiply.outer(np.asarray(t, dtype=float) * frequency, harmonics)
+        return np.cos(phase) @ coefficients
+
+    def velocity(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None = None) -> np.ndarray:
+        """u'(t) of the same approximation as :meth:`displacement`."""
+        harmonics, coefficients, frequency = self._combined_coefficients(float(epsilon), values)
+        phase = np.multiply.outer(np.asarray(t, dtype=float) * frequency, harmonics)
+        return -np.sin(phase) @ (coefficients * harmonics) * frequency
+
+    # -- symbolic views and exports -------------------------------------------------------
+    def frequency_expr(self, order: int | None = None) -> sympy.Expr:
+        """ω(ε) truncated at ``order`` as a sympy polynomial in ``epsilon``."""
+        order = self.order if order is None else order
+        return sympy.Add(*[self.omega_correction(k) * EPSILON**k for k in range(order + 1)])
+
+    def displacement_expr(self) -> sympy.Expr:
+        """u(t; ε) = Σ_{k≤N} ε^k v_k(ω t) with ω through ω_{N+1}, as a sympy expression."""
+        frequency = self.frequency_expr(self.order + 1)
+        return sympy.Add(*[EPSILON**w.order * w.to_expr(frequency * TIME) for w in self.waveforms])
+
+    @property
+    def arguments(self) -> tuple[sympy.Symbol, ...]:
+        """Free symbols of the results (sorted by name): the trailing arguments of :meth:`lambdify`."""
+        return tuple(sorted(self.problem.free_symbols, key=lambda symbol: symbol.name))
+
+    def lambdify(self, quantity: str = "displacement", modules: str = "numpy") -> Callable[..., Any]:
+        """A vectorised numeric function generated through ``sympy.lambdify``.
+
+        ``quantity="displacement"`` gives ``u(t, epsilon, *arguments)``;
+        ``quantity="frequency"`` gives ``omega(epsilon, *arguments)``.
+
+        Examples
+        --------
+        >>> import lindstedt, numpy as np
+        >>> e = lindstedt.expand("u**3", order=2, a0=1, omega0=1)
+        >>> omega = e.lambdify("frequency")
+        >>> round(float(omega(0.1)), 12)
+        1.0366796875
+        """
+        if quantity == "displacement":
+            return sympy.lambdify((TIME, EPSILON, *self.arguments), self.displacement_expr(), modules=modules)
+        if quantity == "frequency":
+            return sympy.lambdify((EPSILON, *self.arguments), self.frequency_expr(), modules=modules)
+        raise ValueError("quantity must be 'displacement' or 'frequency'")
+
+    def to_latex(self, *, waveforms: bool = False) -> str:
+        """A LaTeX fragment (``align*``) with the equation, the ω_k and optionally the v_k.
+
+        Waveform LaTeX is built only when ``waveforms=True``.
+        """
+        problem = self.problem
+        u = sympy.Symbol("u")
+        equation = (
+            r"\ddot u + " + _latex(problem.omega0**2) + r" u + \varepsilon\left(" + _latex(problem.f.subs(problem.variable, u)) + r"\right) = 0"
+        )
+        lines = [equation + r",\quad u(0) = " + (_latex(problem.a0) if problem.normalization == "initial" else r"\dots")]
+        for k, value in enumerate(self.omega):
+            lines.append(rf"\omega_{{{k}}} &= {_latex(value)}")
+        lines.append(r"\omega(\varepsilon) &= " + _latex(self.frequency_expr()) + rf" + O(\varepsilon^{{{self.order + 1}}})")
+        if waveforms:
+            for waveform in self.waveforms:
+                lines.append(rf"v_{{{waveform.order}}}(s) &= {waveform.to_latex()}")
+        header = f"% lindstedt: {problem.describe()}\n"
+        return header + "\\begin{align*}\n" + " \\\\\n".join(lines) + "\n\\end{align*}\n"
+
+    def to_dict(self, *, waveforms: bool = True) -> dict[str, Any]:
+        """The documented JSON-ready dictionary (schema ``lindstedt.expansion/1``)."""
+        problem = self.problem
+        data: dict[str, Any] = {
+            "schema": SCHEMA,
+            "problem": {
+                "equation": "u'' + omega0**2*u + epsilon*f(u) = 0, u'(0) = 0",
+                "f": sympy.sstr(problem.f),
+                "a0": sympy.sstr(problem.a0),
+                "omega0": sympy.sstr(problem.omega0),
+                "parameters": {str(symbol): sympy.sstr(value) for symbol, value in problem.params},
+                "normalization": problem.normalization,
+            },
+            "order": self.order,
+            "normalization": problem.normalization,
+            "omega": [sympy.sstr(value) for value in self.omega],
+            "omega_float": [_as_float(value) for value in self.omega],
+            "alpha": [sympy.sstr(value) for value in self.alpha],
+            "alpha_float": [_as_float(value) for value in self.alpha],
+            "omega_next": sympy.sstr(self.omega_next),
+        }
+        if waveforms:
+            data["waveforms"] = [
+                {"order": w.order, "cosine_coefficients": {str(n): sympy.sstr(c) for n, c in w.coefficients}}
+                for w in self.waveforms
+            ]
+        return data
+
+    def to_json(self, *, waveforms: bool = True, indent: int | None = 2) -> str:
+        """JSON text of :meth:`to_dict`."""
+        return json.dumps(self.to_dict(waveforms=waveforms), indent=indent)
+
+    def summary(self) -> str:
+        """Plain-text summary: the problem and ω_0..ω_N."""
+        lines = [self.problem.describe()]
+        for k, value in enumerate(self.omega):
+            lines.append(f"  omega_{k} = {value}")
+        return "\n".join(lines)
