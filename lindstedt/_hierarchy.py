@@ -52,6 +52,7 @@ from ._problem import DISPLACEMENT, Oscillator
 __all__ = ["LindstedtPoincare", "MAX_ORDER", "NormalForm", "SmoothHierarchy", "normal_form"]
 
 MAX_ORDER = 100
+_MAX_CHEBYSHEV_NODES = 512
 _NORMALISED = sympy.Symbol("w", real=True)
 
 
@@ -145,6 +146,7 @@ def _analytic_normal_form(problem: Oscillator, digits: int) -> NormalForm:
         )
     amplitude, omega0 = problem.a0, problem.omega0
     scaled = problem.nonlinearity.subs(DISPLACEMENT, amplitude * _NORMALISED) / (amplitude * omega0**2)
+    _check_continuous_on_orbit(scaled, problem)
     domain = RealField(dps=digits)
     tolerance = 10.0 ** (-(digits + 2))
     cache: dict[int, CosineSeries] = {}
@@ -162,11 +164,24 @@ def _analytic_normal_form(problem: Oscillator, digits: int) -> NormalForm:
     return NormalForm(domain, sympy.Integer(1), (), taylor_series, tolerance, None)
 
 
+def _check_continuous_on_orbit(scaled: sympy.Expr, problem: Oscillator) -> None:
+    orbit = sympy.Interval(-1, 1)
+    try:
+        domain = sympy.calculus.util.continuous_domain(scaled, _NORMALISED, orbit)
+    except (NotImplementedError, TypeError, ValueError):  # sympy cannot decide: the numeric checks decide
+        return
+    if domain != orbit:
+        raise UnsupportedNonlinearityError(
+            f"f = {problem.f} is not continuous on the whole orbit |u| <= |a0| = {abs(problem.a0)}; "
+            "the smooth hierarchy needs f analytic on [-|a0|, |a0|]"
+        )
+
+
 def _chebyshev_cosine_series(function: Callable, domain: Any, digits: int, tolerance: float, problem: Oscillator) -> CosineSeries:
     """Cosine coefficients of ``function(cos s)`` (= Chebyshev coefficients) to ``digits``."""
     with mpmath.workdps(digits + 10):
         nodes = 32
-        while nodes <= 4096:
+        while nodes <= _MAX_CHEBYSHEV_NODES:
             angles = [mpmath.pi * (j + mpmath.mpf(1) / 2) / nodes for j in range(nodes)]
             try:
                 samples = [mpmath.mpf(function(mpmath.cos(angle))) for angle in angles]
@@ -187,13 +202,28 @@ def _chebyshev_cosine_series(function: Callable, domain: Any, digits: int, toler
             scale = max(abs(c) for c in coefficients) or mpmath.mpf(1)
             tail = max(abs(c) for c in coefficients[-nodes // 4 :])
             if tail <= tolerance * scale:
-                kept = {n: domain.convert(c) for n, c in enumerate(coefficients) if abs(c) > tolerance * scale}
-                return CosineSeries(domain, kept)
+                # Independent check off the sampling grid (catches poles between nodes).
+                for point in (mpmath.mpf(1), mpmath.mpf(-1), mpmath.mpf("0.3183"), mpmath.mpf("-0.7071")):
+                    exact = mpmath.mpf(function(point))
+                    value = _clenshaw(coefficients, point)
+                    if not mpmath.isfinite(exact) or abs(value - exact) > 1000 * tolerance * max(scale, abs(exact)):
+                        break
+                else:
+                    kept = {n: domain.convert(c) for n, c in enumerate(coefficients) if abs(c) > tolerance * scale}
+                    return CosineSeries(domain, kept)
             nodes *= 2
     raise UnsupportedNonlinearityError(
-        f"the Chebyshev coefficients of f = {problem.f} on the orbit do not decay to 1e-{digits} "
-        "within 4096 harmonics; f is not analytic enough on [-|a0|, |a0|] for this precision"
+        f"the Chebyshev coefficients of f = {problem.f} on the orbit do not converge to 1e-{digits} "
+        f"within {_MAX_CHEBYSHEV_NODES} harmonics; f is not analytic enough on [-|a0|, |a0|] for this precision"
     )
+
+
+def _clenshaw(coefficients: list, point: Any) -> Any:
+    """Σ c_n T_n(point) by Clenshaw's recurrence."""
+    following = current = mpmath.mpf(0)
+    for coefficient in reversed(coefficients[1:]):
+        current, following = 2 * point * current - following + coefficient, current
+    return point * current - following + coefficients[0]
 
 
 def normal_form(problem: Oscillator, digits: int = 30) -> NormalForm:

@@ -1,0 +1,120 @@
+"""Command-line interface ``lindstedt`` (expansions of u'' + ω0² u + ε f(u) = 0 and friends).
+
+Sub-commands
+------------
+``lindstedt expand F --order N [--a0 A] [--omega0 W] [--param NAME=VALUE ...]
+[--normalization initial|harmonic] [--format text|latex|json]``
+    Lindstedt–Poincaré expansion of the oscillator with nonlinearity F.
+``lindstedt demo``
+    The tour: derives the Duffing and unilateral-spring expansions, prints them
+    and their agreement with the exact references.
+
+Errors in the input print ``error: <message naming the fix>`` and exit with status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Sequence
+
+from ._errors import LindstedtError
+
+__all__ = ["main", "build_parser"]
+
+
+def _parse_parameters(items: Sequence[str]) -> dict[str, str | None]:
+    parameters: dict[str, str | None] = {}
+    for item in items:
+        if "=" in item:
+            name, value = item.split("=", 1)
+            parameters[name.strip()] = value.strip()
+        else:
+            parameters[item.strip()] = None
+    return parameters
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``lindstedt`` command."""
+    parser = argparse.ArgumentParser(
+        prog="lindstedt",
+        description="Exact Lindstedt-Poincare expansions of u'' + omega0^2 u + eps f(u) = 0, checked against exact references.",
+    )
+    commands = parser.add_subparsers(dest="command", required=True)
+
+    expand = commands.add_parser("expand", help="expand u'' + omega0^2 u + eps f(u) = 0 to a given order")
+    expand.add_argument("f", help="the nonlinearity f(u), e.g. 'u**3' or 'u**3 + c*u**5'")
+    expand.add_argument("--order", type=int, default=2, help="highest order N (default 2)")
+    expand.add_argument("--a0", default=None, help="amplitude a0 (number or symbol name; default: symbol a0)")
+    expand.add_argument("--omega0", default=None, help="linear angular frequency (default: symbol omega0)")
+    expand.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="declare a parameter of f with its value; NAME alone keeps it symbolic (repeatable)",
+    )
+    expand.add_argument("--normalization", choices=("initial", "harmonic"), default="initial")
+    expand.add_argument("--format", choices=("text", "latex", "json"), default="text")
+    expand.add_argument("--waveforms", action="store_true", help="include the waveforms v_k in text/LaTeX output")
+    expand.add_argument("--precision", type=int, default=30, help="decimal digits for non-polynomial f (default 30)")
+
+    demo = commands.add_parser("demo", help="the tour: Duffing and u_+ expansions checked against exact references")
+    demo.add_argument("--order", type=int, default=8, help="Duffing order to derive (default 8)")
+    return parser
+
+
+def _command_expand(arguments: argparse.Namespace) -> str:
+    from ._api import expand
+
+    expansion = expand(
+        arguments.f,
+        order=arguments.order,
+        a0=arguments.a0,
+        omega0=arguments.omega0,
+        params=_parse_parameters(arguments.param),
+        normalization=arguments.normalization,
+        precision=arguments.precision,
+    )
+    if arguments.format == "json":
+        return expansion.to_json()
+    if arguments.format == "latex":
+        return expansion.to_latex(waveforms=arguments.waveforms)
+    text = expansion.summary()
+    if arguments.waveforms:
+        text += "\n" + "\n".join(f"  v_{w.order}(s) = {w.to_expr()}" for w in expansion.waveforms)
+    return text
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit status.
+
+    Examples
+    --------
+    >>> main(["expand", "u**3", "--order", "1", "--a0", "1", "--omega0", "1"])
+    u'' + 1**2*u + eps*(u**3) = 0, u(0) = 1 [initial]
+      omega_0 = 1
+      omega_1 = 3/8
+    0
+    """
+    parser = build_parser()
+    arguments = parser.parse_args(argv)
+    try:
+        if arguments.command == "expand":
+            output = _command_expand(arguments)
+        elif arguments.command == "demo":
+            from ._demo import run_demo
+
+            output = run_demo(order=arguments.order)
+        else:  # pragma: no cover - argparse enforces the choices
+            parser.error(f"unknown command {arguments.command}")
+            return 2
+    except LindstedtError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    print(output)
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
