@@ -10,7 +10,7 @@ from ._problem import Oscillator
 
 __all__ = ["expand"]
 
-_DEFAULT_METHODS: dict[int, LindstedtPoincare] = {}
+_DEFAULT_METHODS: dict[tuple[int, bool], LindstedtPoincare] = {}
 
 
 def expand(
@@ -22,6 +22,7 @@ def expand(
     params: Mapping[str, Any] | None = None,
     normalization: str = "initial",
     precision: int = 30,
+    numeric: bool = False,
 ) -> Expansion:
     """Lindstedt–Poincaré expansion of ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0``, ``u'(0) = 0``.
 
@@ -39,7 +40,10 @@ def expand(
     normalization : {"initial", "harmonic"}
         ``a0`` is u(0), or the first-harmonic amplitude.
     precision : int
-        Decimal digits for non-polynomial f (computed numerically).
+        Decimal digits for non-polynomial f (computed numerically) and for ``numeric=True``.
+    numeric : bool
+        Piecewise-linear f: work in ``precision``-digit floats instead of exactly
+        (much faster at high order; exact inputs otherwise give exact results).
 
     Returns
     -------
@@ -58,7 +62,8 @@ def expand(
         problem = f
     else:
         problem = Oscillator(f, a0=a0, omega0=omega0, params=params, normalization=normalization)
-    method = _DEFAULT_METHODS.get(precision)
+    key = (precision, bool(numeric))
+    method = _DEFAULT_METHODS.get(key)
     if method is None:
-        method = _DEFAULT_METHODS[precision] = LindstedtPoincare(precision=precision)
+        method = _DEFAULT_METHODS[key] = LindstedtPoincare(precision=precision, numeric=numeric)
     return method.expand(problem, order)

@@ -38,10 +38,12 @@ import numpy as np
 import sympy
 
 from ._errors import OrderError
+from ._branch import Branch, EvaluationPoint
 from ._hierarchy import MAX_ORDER, SmoothHierarchy
+from ._piecewise_hierarchy import PiecewiseHierarchy
 from ._problem import Oscillator
 
-__all__ = ["Expansion", "Waveform", "STRAINED_TIME", "EPSILON", "TIME"]
+__all__ = ["Expansion", "Waveform", "PiecewiseWaveform", "STRAINED_TIME", "EPSILON", "TIME"]
 
 STRAINED_TIME = sympy.Symbol("s", real=True)
 EPSILON = sympy.Symbol("epsilon", real=True)
@@ -101,6 +103,73 @@ class Waveform:
         return _latex(self.to_expr())
 
 
+def _fold(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Reduce s to [0, π] using evenness and 2π-periodicity; also the sign of d/ds."""
+    shifted = np.mod(s + np.pi, 2 * np.pi) - np.pi
+    return np.abs(shifted), np.where(shifted < 0, -1.0, 1.0)
+
+
+def _branch_float_terms(branch_terms: list[tuple[int, int, int, float]], s: np.ndarray) -> np.ndarray:
+    total = np.zeros_like(s)
+    for harmonic, parity, power, value in branch_terms:
+        trig = np.cos(harmonic * s) if parity == 0 else np.sin(harmonic * s)
+        total = total + value * s**power * trig
+    return total
+
+
+@dataclass(frozen=True)
+class PiecewiseWaveform:
+    """A correction v_k of a piecewise-linear problem, exact and piecewise in closed form.
+
+    The even 2π-periodic function is given by its restriction to [0, π]:
+    ``branches[p]`` holds on ``[breakpoints[p-1], breakpoints[p]]`` with
+    ``breakpoints`` the contact angles β_i (fixed-s expansion).  Its cosine
+    series ``Σ d_n cos(n s)`` is available exactly through
+    :meth:`cosine_coefficient`.
+
+    Examples
+    --------
+    >>> import lindstedt
+    >>> v1 = lindstedt.expand("Max(0, u)", order=1, a0=1, omega0=1).waveforms[1]
+    >>> v1.breakpoints
+    (pi/2,)
+    >>> v1.cosine_coefficient(2)
+    -1/(3*pi)
+    """
+
+    order: int
+    breakpoints: tuple[sympy.Expr, ...]
+    branches: tuple[sympy.Expr, ...]
+    _pieces: tuple[Branch, ...] = field(repr=False, compare=False)
+    _limits: tuple[EvaluationPoint, ...] = field(repr=False, compare=False)
+    _convert: Any = field(repr=False, compare=False)
+
+    def to_expr(self, variable: sympy.Symbol = STRAINED_TIME) -> sympy.Expr:
+        """Sympy ``Piecewise`` on [0, π] (extend evenly and 2π-periodically)."""
+        conditions = [(branch.subs(STRAINED_TIME, variable), variable <= limit) for branch, limit in zip(self.branches, self.breakpoints)]
+        conditions.append((self.branches[-1].subs(STRAINED_TIME, variable), True))
+        return sympy.Piecewise(*conditions)
+
+    def cosine_coefficient(self, harmonic: int) -> sympy.Expr:
+        """Exact d_n = (2/π) ∫_0^π v_k(s) cos(ns) ds (1/π for n = 0)."""
+        if not isinstance(harmonic, int) or harmonic < 0:
+            raise ValueError("harmonic must be a non-negative integer")
+        total = None
+        for piece, lower, upper in zip(self._pieces, self._limits, self._limits[1:]):
+            value = piece.times_cosine(harmonic).integral(lower, upper)
+            total = value if total is None else total + value
+        weight = sympy.Integer(1 if harmonic == 0 else 2) / sympy.pi
+        return sympy.simplify(weight * self._convert(total))
+
+    def cosine_coefficients(self, highest: int) -> tuple[sympy.Expr, ...]:
+        """(d_0, …, d_highest)."""
+        return tuple(self.cosine_coefficient(n) for n in range(highest + 1))
+
+    def value_at_zero(self) -> sympy.Expr:
+        """v_k(0) exactly."""
+        return sympy.simplify(self.branches[0].subs(STRAINED_TIME, 0))
+
+
 @dataclass(frozen=True)
 class Expansion:
     """Lindstedt–Poincaré expansion of an :class:`~lindstedt.Oscillator` to a given order.
@@ -120,7 +189,35 @@ class Expansion:
 
     problem: Oscillator
     order: int
-    _hierarchy: SmoothHierarchy = field(repr=False, compare=False)
+    _hierarchy: SmoothHierarchy | PiecewiseHierarchy = field(repr=False, compare=False)
+
+    @property
+    def is_piecewise(self) -> bool:
+        """True for piecewise-linear f (unilateral springs)."""
+        return isinstance(self._hierarchy, PiecewiseHierarchy)
+
+    @property
+    def regime(self) -> str:
+        """``"smooth"``, or for piecewise f: ``"contact"``, ``"no contact"`` or ``"grazing"``."""
+        return self._hierarchy.form.regime if self.is_piecewise else "smooth"
+
+    @property
+    def validity_exponent(self) -> sympy.Rational:
+        """p in the validity time T_ε ~ ε^p: −1 (simple roots of v0 − b), −1/2 (grazing, double root)."""
+        return self._hierarchy.form.validity_exponent if self.is_piecewise else sympy.Integer(-1)
+
+    @property
+    def contact_angles(self) -> tuple[sympy.Expr, ...]:
+        """β_i = arccos κ_i of the contact boundaries crossed by v_0 (empty for smooth f)."""
+        if not self.is_piecewise:
+            return ()
+        return tuple(boundary.contact_angle for boundary in self._hierarchy.form.boundaries)
+
+    def contact_angle_correction(self, order: int) -> tuple[sympy.Expr, ...]:
+        """σ_{i,order}: the ε^order coefficient of the moving contact angles s_i*(ε)."""
+        if not self.is_piecewise:
+            return ()
+        return tuple(self._to_expr(value, order, sympy.Integer(1)) for value in self._hierarchy.boundary_shift(order))
 
     # -- exact quantities ---------------------------------------------------------------
     @property
@@ -130,7 +227,7 @@ class Expansion:
     def _to_expr(self, element: Any, power: int, prefactor: sympy.Expr) -> sympy.Expr:
         value = self._hierarchy.form.to_expr(element)
         expression = prefactor * self._scale**power * value
-        if self._hierarchy.form.generator_values:
+        if self._hierarchy.form.generator_values and not self.is_piecewise:
             expression = sympy.expand(expression)
         return expression
 
@@ -148,9 +245,23 @@ class Expansion:
         self._check(order)
         return self._to_expr(self._hierarchy.squared_frequency(order), order, self.problem.omega0**2)
 
-    def waveform(self, order: int) -> Waveform:
-        """Exact v_order(s) as a :class:`Waveform`."""
+    def waveform(self, order: int) -> Waveform | PiecewiseWaveform:
+        """Exact v_order(s): a :class:`Waveform` (smooth f) or :class:`PiecewiseWaveform`."""
         self._check(order)
+        if self.is_piecewise:
+            form = self._hierarchy.form
+            pieces = tuple(self._hierarchy.branches(order))
+            scale = self.problem.a0 * self._scale**order
+            branches = tuple(scale * piece.to_expr(STRAINED_TIME, form.to_expr) for piece in pieces)
+            limits = (form.zero_point, *[b.point for b in form.boundaries], form.pi_point)
+            return PiecewiseWaveform(
+                order=order,
+                breakpoints=self.contact_angles,
+                branches=branches,
+                _pieces=pieces,
+                _limits=limits,
+                _convert=lambda element, scale=scale: scale * form.to_expr(element),
+            )
         series = self._hierarchy.waveform(order)
         coefficients = tuple(
             (harmonic, self._to_expr(series.coefficient(harmonic), order, self.problem.a0)) for harmonic in series.harmonics
@@ -168,7 +279,7 @@ class Expansion:
         return tuple(self.alpha_correction(k) for k in range(self.order + 1))
 
     @cached_property
-    def waveforms(self) -> tuple[Waveform, ...]:
+    def waveforms(self) -> tuple[Waveform | PiecewiseWaveform, ...]:
         """(v_0, …, v_N), exact cosine polynomials."""
         return tuple(self.waveform(k) for k in range(self.order + 1))
 
@@ -217,8 +328,61 @@ class Expansion:
         harmonics = np.array(sorted(combined), dtype=float)
         return harmonics, np.array([combined[int(h)] for h in harmonics]), frequency
 
+    def _piecewise_float_data(self, epsilon: float, values: Mapping[Any, Any] | None):
+        substitution = self._substitution(values)
+        form = self._hierarchy.form
+
+        def to_float(element: Any, scale: sympy.Expr) -> float:
+            return float((scale * form.to_expr(element)).xreplace(substitution))
+
+        scale_value = float(self._scale.xreplace(substitution)) * epsilon
+        amplitude = float(self.problem.a0.xreplace(substitution))
+        pieces: list[dict[tuple[int, int, int], float]] = [dict() for _ in form.piece_coefficients]
+        for order in range(self.order + 1):
+            weight = amplitude * scale_value**order
+            for piece, branch in enumerate(self._hierarchy.branches(order)):
+                for key, element in branch.terms.items():
+                    pieces[piece][key] = pieces[piece].get(key, 0.0) + weight * to_float(element, sympy.Integer(1))
+        boundaries = []
+        for index in range(len(form.boundaries)):
+            position = sum(
+                to_float(self._hierarchy.boundary_shift(order)[index], sympy.Integer(1)) * scale_value**order
+                for order in range(self.order + 1)
+            )
+            boundaries.append(position)
+        omegas = self._floats(list(self.omega) + [self.omega_next], values)
+        frequency = float(np.polynomial.polynomial.polyval(epsilon, omegas))
+        terms = [[(j, parity, power, value) for (j, parity, power), value in piece.items()] for piece in pieces]
+        return np.array(boundaries), terms, frequency
+
+    def _piecewise_evaluate(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None, derivative: bool) -> np.ndarray:
+        boundaries, terms, frequency = self._piecewise_float_data(float(epsilon), values)
+        times = np.asarray(t, dtype=float)
+        folded, sign = _fold(times * frequency)
+        piece_index = np.searchsorted(boundaries, folded)
+        result = np.zeros_like(folded)
+        for piece, piece_terms in enumerate(terms):
+            mask = piece_index == piece
+            if not np.any(mask):
+                continue
+            if derivative:
+                derived = []
+                for harmonic, parity, power, value in piece_terms:
+                    # d/ds s^m trig(js) = m s^{m-1} trig(js) ± j s^m trig'(js)
+                    if power:
+                        derived.append((harmonic, parity, power - 1, value * power))
+                    if harmonic:
+                        derived.append((harmonic, 1 - parity, power, value * harmonic * (-1 if parity == 0 else 1)))
+                result[mask] = _branch_float_terms(derived, folded[mask]) * sign[mask] * frequency
+            else:
+                result[mask] = _branch_float_terms(piece_terms, folded[mask])
+        return result if result.ndim else float(result)
+
     def displacement(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None = None) -> np.ndarray:
         """u(t) ≈ Σ_{k≤N} ε^k v_k(ω t), ω through ω_{N+1}; vectorised over ``t``.
+
+        For piecewise-linear f the branches are used up to the *moving* contact
+        angles s_i*(ε) = β_i + Σ σ_{i,k} ε^k, so the error stays O(ε^{N+1}).
 
         Examples
         --------
@@ -227,12 +391,16 @@ class Expansion:
         >>> float(e.displacement(0.0, 0.1))
         1.0
         """
+        if self.is_piecewise:
+            return self._piecewise_evaluate(t, epsilon, values, derivative=False)
         harmonics, coefficients, frequency = self._combined_coefficients(float(epsilon), values)
         phase = np.multiply.outer(np.asarray(t, dtype=float) * frequency, harmonics)
         return np.cos(phase) @ coefficients
 
     def velocity(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None = None) -> np.ndarray:
         """u'(t) of the same approximation as :meth:`displacement`."""
+        if self.is_piecewise:
+            return self._piecewise_evaluate(t, epsilon, values, derivative=True)
         harmonics, coefficients, frequency = self._combined_coefficients(float(epsilon), values)
         phase = np.multiply.outer(np.asarray(t, dtype=float) * frequency, harmonics)
         return -np.sin(phase) @ (coefficients * harmonics) * frequency

@@ -380,7 +380,10 @@ class LindstedtPoincare:
     ----------
     precision : int
         Decimal digits for non-polynomial (analytic) f, whose expansion is
-        numeric.  Polynomial f is always exact.
+        numeric, and for ``numeric=True``.  Polynomial f is always exact.
+    numeric : bool
+        Piecewise-linear f: compute in a ``RealField`` of ``precision`` digits
+        (fast) instead of exactly.  Floats in the input also select it.
 
     Examples
     --------
@@ -390,16 +393,24 @@ class LindstedtPoincare:
     (1, 3/8, -21/256)
     """
 
-    def __init__(self, precision: int = 30):
+    def __init__(self, precision: int = 30, numeric: bool = False):
         if not isinstance(precision, int) or precision < 15 or precision > 1000:
             raise ProblemError("precision must be an integer number of decimal digits between 15 and 1000")
         self.precision = precision
+        self.numeric = bool(numeric)
         self._hierarchies: dict[Oscillator, SmoothHierarchy] = {}
 
-    def hierarchy(self, problem: Oscillator) -> SmoothHierarchy:
-        """The (cached) normalised hierarchy of ``problem``."""
+    def hierarchy(self, problem: Oscillator):
+        """The (cached) normalised hierarchy of ``problem`` (smooth or piecewise-linear)."""
         if problem not in self._hierarchies:
-            self._hierarchies[problem] = SmoothHierarchy(normal_form(problem, self.precision), problem.normalization)
+            if problem.is_non_smooth:
+                from ._piecewise_hierarchy import PiecewiseHierarchy, piecewise_normal_form
+
+                digits = self.precision if self.numeric else None
+                hierarchy = PiecewiseHierarchy(piecewise_normal_form(problem, digits), problem.normalization)
+            else:
+                hierarchy = SmoothHierarchy(normal_form(problem, self.precision), problem.normalization)
+            self._hierarchies[problem] = hierarchy
         return self._hierarchies[problem]
 
     def expand(self, problem: Oscillator, order: int):

@@ -38,10 +38,14 @@ def _default_omega0() -> sympy.Symbol:
     return sympy.Symbol("omega0", positive=True)
 
 
-def _symbol_from_text(text: str, *, positive: bool) -> sympy.Symbol | None:
+def _symbol_from_text(text: str) -> sympy.Expr | None:
+    """``"name"`` -> positive symbol, ``"-name"`` -> its negative; otherwise None."""
     stripped = text.strip()
-    if stripped.isidentifier():
-        return sympy.Symbol(stripped, positive=True) if positive else sympy.Symbol(stripped, real=True, nonzero=True)
+    negative = stripped.startswith("-")
+    name = stripped[1:].strip() if negative else stripped
+    if name.isidentifier():
+        symbol = sympy.Symbol(name, positive=True)
+        return -symbol if negative else symbol
     return None
 
 
@@ -151,7 +155,7 @@ class Oscillator:
         if value is None:
             return _default_amplitude()
         if isinstance(value, str):
-            symbol = _symbol_from_text(value, positive=False)
+            symbol = _symbol_from_text(value)
             amplitude = symbol if symbol is not None else parse_number(value, what="a0")
         else:
             amplitude = sympy.sympify(value)
@@ -171,7 +175,9 @@ class Oscillator:
         if value is None:
             return _default_omega0()
         if isinstance(value, str):
-            symbol = _symbol_from_text(value, positive=True)
+            symbol = _symbol_from_text(value)
+            if symbol is not None and symbol.is_negative:
+                raise ProblemError(f"omega0 must be positive, got {value!r}")
             omega0 = symbol if symbol is not None else parse_number(value, what="omega0")
         else:
             omega0 = sympy.sympify(value)

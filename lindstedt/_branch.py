@@ -1,0 +1,270 @@
+"""Analytic branches: quasi-trigonometric functions Σ c · s^m · cos(j s) / s^m · sin(j s).
+
+On one contact state a piecewise-linear oscillator obeys a linear equation
+with constant coefficients, so every Lindstedt–Poincaré correction is, on that
+state's piece, an *analytic branch*
+
+    B(s) = Σ_{j, m} [ c_{j,m} s^m cos(j s) + d_{j,m} s^m sin(j s) ],
+
+which continues analytically past the piece's ends (that is what lets the
+hierarchy expand a contact boundary that moves with ε).  This module gives the
+exact calculus of such branches with coefficients in any sympy domain
+(``QQ``, a fraction field ``QQ(π, β, …)``, ``RealField``):
+
+* sums, scalar multiples, derivatives, products with ``cos(n s)``;
+* evaluation at a point whose ``cos(j s0)``, ``sin(j s0)`` are known
+  (:class:`EvaluationPoint`, using the Chebyshev recurrences from cos s0, sin s0);
+* exact antiderivatives (integration by parts, memoised over ``QQ``);
+* the particular solution of ``v'' + v = B`` by undetermined coefficients,
+  including the resonant harmonic ``j = 1`` (which raises the power of s).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from typing import Any, Iterable, Mapping
+
+import sympy
+from sympy import QQ
+
+__all__ = ["Branch", "EvaluationPoint"]
+
+# A term key is (harmonic j >= 0, parity 0 = cos / 1 = sin, power m >= 0); (0, 1, m) never occurs.
+TermKey = tuple[int, int, int]
+_RationalTerms = tuple[tuple[TermKey, Any], ...]
+
+
+def _add_into(target: dict, key: TermKey, value: Any) -> None:
+    if key[0] == 0 and key[1] == 1:
+        return  # sin(0 s) = 0
+    target[key] = target[key] + value if key in target else value
+
+
+@lru_cache(maxsize=None)
+def _oscillator_inverse(key: TermKey) -> _RationalTerms:
+    """Particular solution over QQ of v'' + v = s^m trig_j(s) (one basis term)."""
+    harmonic, parity, power = key
+    result: dict[TermKey, Any] = {}
+    if harmonic == 1:
+        # v'' + v = s^m cos s: top term s^{m+1} sin s / (2(m+1)); the residual is (m/2) s^{m-1} sin s.
+        # v'' + v = s^m sin s: top term -s^{m+1} cos s / (2(m+1)); the residual is -(m/2) s^{m-1} cos s.
+        top = (1, 1 - parity, power + 1)
+        sign = 1 if parity == 0 else -1
+        _add_into(result, top, QQ(sign, 2 * (power + 1)))
+        if power >= 1:
+            residual_key = (1, 1 - parity, power - 1)
+            residual_coefficient = QQ(sign * power, 2)
+            for sub_key, value in _oscillator_inverse(residual_key):
+                _add_into(result, sub_key, -residual_coefficient * value)
+    else:
+        factor = QQ(1, 1 - harmonic * harmonic)
+        _add_into(result, key, factor)
+        # L[s^m cos js] = (1 - j²) s^m cos js + m(m-1) s^{m-2} cos js - 2 j m s^{m-1} sin js
+        # L[s^m sin js] = (1 - j²) s^m sin js + m(m-1) s^{m-2} sin js + 2 j m s^{m-1} cos js
+        residuals: list[tuple[TermKey, Any]] = []
+        if power >= 2:
+            residuals.append(((harmonic, parity, power - 2), QQ(power * (power - 1))))
+        if power >= 1 and harmonic:
+            sign = -1 if parity == 0 else 1
+            residuals.append(((harmonic, 1 - parity, power - 1), QQ(sign * 2 * harmonic * power)))
+        for residual_key, coefficient in residuals:
+            for sub_key, value in _oscillator_inverse(residual_key):
+                _add_into(result, sub_key, -factor * coefficient * value)
+    return tuple((k, v) for k, v in result.items() if v)
+
+
+@lru_cache(maxsize=None)
+def _antiderivative(key: TermKey) -> _RationalTerms:
+    """An antiderivative over QQ of s^m trig_j(s) (integration by parts)."""
+    harmonic, parity, power = key
+    result: dict[TermKey, Any] = {}
+    if harmonic == 0:
+        _add_into(result, (0, 0, power + 1), QQ(1, power + 1))
+        return tuple(result.items())
+    # ∫ s^m cos js = s^m sin(js)/j - (m/j) ∫ s^{m-1} sin js
+    # ∫ s^m sin js = -s^m cos(js)/j + (m/j) ∫ s^{m-1} cos js
+    sign = 1 if parity == 0 else -1
+    _add_into(result, (harmonic, 1 - parity, power), QQ(sign, harmonic))
+    if power >= 1:
+        for sub_key, value in _antiderivative((harmonic, 1 - parity, power - 1)):
+            _add_into(result, sub_key, QQ(-sign * power, harmonic) * value)
+    return tuple((k, v) for k, v in result.items() if v)
+
+
+class EvaluationPoint:
+    """A point s0 with exact (domain) values of s0^m, cos(j s0) and sin(j s0).
+
+    Parameters
+    ----------
+    domain : sympy domain
+    value, cosine, sine : domain elements
+        s0, cos(s0) and sin(s0).
+
+    Examples
+    --------
+    >>> from sympy import QQ
+    >>> point = EvaluationPoint(QQ, QQ(0), QQ(1), QQ(0))
+    >>> point.cos_multiple(3), point.sin_multiple(3)
+    (1, 0)
+    """
+
+    def __init__(self, domain: Any, value: Any, cosine: Any, sine: Any):
+        self.domain = domain
+        self.value = value
+        self._cos = [domain.one, cosine]
+        self._sin = [domain.zero, sine]
+        self._powers = [domain.one]
+
+    def power(self, exponent: int) -> Any:
+        """s0 ** exponent."""
+        while len(self._powers) <= exponent:
+            self._powers.append(self._powers[-1] * self.value)
+        return self._powers[exponent]
+
+    def _extend(self, harmonic: int) -> None:
+        while len(self._cos) <= harmonic:
+            # cos((j+1)x) = 2 cos x cos jx - cos((j-1)x); same recurrence for sin.
+            two_cos = self._cos[1] + self._cos[1]
+            self._cos.append(two_cos * self._cos[-1] - self._cos[-2])
+            self._sin.append(two_cos * self._sin[-1] - self._sin[-2])
+
+    def cos_multiple(self, harmonic: int) -> Any:
+        """cos(harmonic · s0)."""
+        self._extend(harmonic)
+        return self._cos[harmonic]
+
+    def sin_multiple(self, harmonic: int) -> Any:
+        """sin(harmonic · s0)."""
+        self._extend(harmonic)
+        return self._sin[harmonic]
+
+
+class Branch:
+    """Quasi-trigonometric function ``Σ c · s^m · cos(j s)`` + ``Σ d · s^m · sin(j s)``.
+
+    Examples
+    --------
+    >>> from sympy import QQ
+    >>> cosine = Branch.cosine(QQ)
+    >>> particular = cosine.oscillator_particular_solution()   # v'' + v = cos s
+    >>> particular.terms == {(1, 1, 1): QQ(1, 2)}            # s sin(s) / 2
+    True
+    """
+
+    __slots__ = ("domain", "terms")
+
+    def __init__(self, domain: Any, terms: Mapping[TermKey, Any] | None = None):
+        self.domain = domain
+        self.terms = {key: value for key, value in (terms or {}).items() if value and not (key[0] == 0 and key[1] == 1)}
+
+    @classmethod
+    def cosine(cls, domain: Any, harmonic: int = 1, amplitude: Any = None) -> "Branch":
+        """amplitude · cos(harmonic s)."""
+        return cls(domain, {(harmonic, 0, 0): domain.one if amplitude is None else amplitude})
+
+    @classmethod
+    def sine(cls, domain: Any, harmonic: int = 1, amplitude: Any = None) -> "Branch":
+        """amplitude · sin(harmonic s)."""
+        return cls(domain, {(harmonic, 1, 0): domain.one if amplitude is None else amplitude})
+
+    @classmethod
+    def constant(cls, domain: Any, value: Any) -> "Branch":
+        """The constant ``value``."""
+        return cls(domain, {(0, 0, 0): value})
+
+    def is_zero(self) -> bool:
+        """True when there are no terms."""
+        return not self.terms
+
+    def __add__(self, other: "Branch") -> "Branch":
+        result = dict(self.terms)
+        for key, value in other.terms.items():
+            _add_into(result, key, value)
+        return Branch(self.domain, result)
+
+    def __neg__(self) -> "Branch":
+        return Branch(self.domain, {key: -value for key, value in self.terms.items()})
+
+    def __sub__(self, other: "Branch") -> "Branch":
+        return self + (-other)
+
+    def scale(self, factor: Any) -> "Branch":
+        """Multiply by the domain element ``factor``."""
+        if not factor:
+            return Branch(self.domain)
+        return Branch(self.domain, {key: value * factor for key, value in self.terms.items()})
+
+    def _from_rational(self, rational_terms: Iterable[tuple[TermKey, Any]], factor: Any, into: dict) -> None:
+        convert = self.domain.convert
+        for key, value in rational_terms:
+            _add_into(into, key, factor * convert(value))
+
+    def derivative(self) -> "Branch":
+        """d/ds, exactly."""
+        result: dict[TermKey, Any] = {}
+        convert = self.domain.convert
+        for (harmonic, parity, power), value in self.terms.items():
+            if power:
+                _add_into(result, (harmonic, parity, power - 1), value * convert(power))
+            if harmonic:
+                sign = -1 if parity == 0 else 1
+                _add_into(result, (harmonic, 1 - parity, power), value * convert(sign * harmonic))
+        return Branch(self.domain, result)
+
+    def times_cosine(self, harmonic: int) -> "Branch":
+        """Product with cos(harmonic · s) (product-to-sum)."""
+        result: dict[TermKey, Any] = {}
+        half = self.domain.convert(QQ(1, 2))
+        for (j, parity, power), value in self.terms.items():
+            half_value = value * half
+            _add_into(result, (j + harmonic, parity, power), half_value)
+            difference = j - harmonic
+            if difference >= 0:
+                _add_into(result, (difference, parity, power), half_value)
+            else:  # sin(-x) = -sin(x)
+                _add_into(result, (-difference, parity, power), half_value if parity == 0 else -half_value)
+        return Branch(self.domain, result)
+
+    def oscillator_particular_solution(self) -> "Branch":
+        """A particular solution of ``v'' + v = self`` (resonant j = 1 handled)."""
+        result: dict[TermKey, Any] = {}
+        for key, value in self.terms.items():
+            self._from_rational(_oscillator_inverse(key), value, result)
+        return Branch(self.domain, result)
+
+    def antiderivative(self) -> "Branch":
+        """An antiderivative (constant of integration zero)."""
+        result: dict[TermKey, Any] = {}
+        for key, value in self.terms.items():
+            self._from_rational(_antiderivative(key), value, result)
+        return Branch(self.domain, result)
+
+    def evaluate(self, point: EvaluationPoint) -> Any:
+        """Exact value at ``point``."""
+        total = self.domain.zero
+        for (harmonic, parity, power), value in self.terms.items():
+            trig = point.cos_multiple(harmonic) if parity == 0 else point.sin_multiple(harmonic)
+            if trig:
+                total = total + value * point.power(power) * trig
+        return total
+
+    def integral(self, lower: EvaluationPoint, upper: EvaluationPoint) -> Any:
+        """∫_lower^upper of the branch, exactly."""
+        primitive = self.antiderivative()
+        return primitive.evaluate(upper) - primitive.evaluate(lower)
+
+    def to_expr(self, variable: sympy.Symbol, to_sympy: Any = None) -> sympy.Expr:
+        """Sympy expression in ``variable`` (``to_sympy`` converts coefficients)."""
+        convert = to_sympy or self.domain.to_sympy
+        terms = []
+        for (harmonic, parity, power), value in self.terms.items():
+            trig = sympy.cos(harmonic * variable) if parity == 0 else sympy.sin(harmonic * variable)
+            terms.append(convert(value) * variable**power * trig)
+        return sympy.Add(*terms)
+
+    def max_power(self) -> int:
+        """Highest power of s present (−1 for zero)."""
+        return max((power for _, _, power in self.terms), default=-1)
+
+    def __repr__(self) -> str:
+        return f"Branch({self.terms})"

@@ -1,0 +1,167 @@
+"""Continuous piecewise-linear nonlinearities f(u), e.g. unilateral springs a·(u − b)_+.
+
+Any continuous piecewise-linear f can be written with breakpoints
+``u_1 < … < u_n`` and one linear function ``f(u) = λ_j u + μ_j`` on each of
+the n + 1 intervals.  :func:`decompose_piecewise_linear` finds that form from
+an expression written with ``Max``/``Min``/``Abs``/``Heaviside``/``sign``
+(``a*Max(0, u - b)``, ``a*(u - b)*Heaviside(u - b)``, sums of several springs
+on either side, ``Max(0, -u - b)`` for a spring acting on negative
+displacements), checks continuity, and refuses anything else with a message
+that names what is supported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy
+
+from ._errors import UnsupportedNonlinearityError
+
+__all__ = ["LinearInterval", "decompose_piecewise_linear"]
+
+_SWITCHING = (sympy.Max, sympy.Min, sympy.Abs, sympy.Heaviside, sympy.sign)
+_SUPPORTED = (
+    "supported non-smooth f: continuous piecewise-linear sums such as a*Max(0, u - b), "
+    "a*(u - b)*Heaviside(u - b), Max(0, -u - b), Abs(u - b), plus linear terms"
+)
+
+
+@dataclass(frozen=True)
+class LinearInterval:
+    """f(u) = slope·u + intercept for u between ``lower`` and ``upper`` (None = unbounded)."""
+
+    lower: sympy.Expr | None
+    upper: sympy.Expr | None
+    slope: sympy.Expr
+    intercept: sympy.Expr
+
+
+def _switching_atoms(expression: sympy.Expr) -> list[sympy.Expr]:
+    atoms = []
+    for atom in sympy.preorder_traversal(expression):
+        if isinstance(atom, _SWITCHING):
+            atoms.append(atom)
+    return atoms
+
+
+def _linear_argument(argument: sympy.Expr, variable: sympy.Symbol, f: sympy.Expr) -> tuple[sympy.Expr, sympy.Expr]:
+    polynomial = sympy.Poly(sympy.expand(argument), variable) if argument.has(variable) else None
+    if polynomial is None:
+        return sympy.Integer(0), argument
+    if polynomial.degree() > 1 or any(_switching_atoms(c) for c in polynomial.coeffs()):
+        raise UnsupportedNonlinearityError(f"f = {f}: the switching argument {argument} is not linear in u; {_SUPPORTED}")
+    slope = polynomial.coeff_monomial(variable)
+    offset = polynomial.coeff_monomial(1)
+    if not slope.is_number:
+        raise UnsupportedNonlinearityError(
+            f"f = {f}: the slope of {argument} in u must be a number (gaps may be symbolic); {_SUPPORTED}"
+        )
+    return slope, offset
+
+
+def _branch_value(atom: sympy.Expr, sign_of_argument: int) -> sympy.Expr:
+    """The smooth expression that a switching atom equals where its argument has the given sign."""
+    if isinstance(atom, sympy.Heaviside):
+        return sympy.Integer(1 if sign_of_argument > 0 else 0)
+    if isinstance(atom, sympy.sign):
+        return sympy.Integer(sign_of_argument)
+    if isinstance(atom, sympy.Abs):
+        return atom.args[0] * sign_of_argument
+    # Max/Min with two arguments: decided by the sign of (first - second).
+    first, second = atom.args
+    if isinstance(atom, sympy.Max):
+        return first if sign_of_argument > 0 else second
+    return second if sign_of_argument > 0 else first
+
+
+def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[LinearInterval]:
+    """Split a continuous piecewise-linear f(u) into linear intervals.
+
+    Returns
+    -------
+    list of LinearInterval
+        Ordered by u; consecutive intervals share a breakpoint.
+
+    Raises
+    ------
+    UnsupportedNonlinearityError
+        For a non-linear piece, a jump (e.g. a pure Heaviside force), nested
+        switches, Max/Min of more than two arguments, or breakpoints whose
+        order cannot be decided (several symbolic gaps).
+
+    Examples
+    --------
+    >>> import sympy
+    >>> u, b = sympy.Symbol("u", real=True), sympy.Symbol("b", real=True)
+    >>> [(i.slope, i.intercept) for i in decompose_piecewise_linear(2*sympy.Max(0, u - b), u)]
+    [(0, 0), (2, -2*b)]
+    """
+    atoms = _switching_atoms(f)
+    switching: list[tuple[sympy.Expr, sympy.Expr]] = []  # (atom, argument whose sign decides it)
+    for atom in atoms:
+        if any(_switching_atoms(argument) for argument in atom.args):
+            raise UnsupportedNonlinearityError(f"f = {f}: nested switching functions are not supported; {_SUPPORTED}")
+        if isinstance(atom, (sympy.Max, sympy.Min)):
+            if len(atom.args) != 2:
+                raise UnsupportedNonlinearityError(f"f = {f}: Max/Min must have exactly two arguments; {_SUPPORTED}")
+            switching.append((atom, atom.args[0] - atom.args[1]))
+        else:
+            switching.append((atom, atom.args[0]))
+    breakpoints: list[sympy.Expr] = []
+    slopes: list[sympy.Expr] = []
+    for _, argument in switching:
+        slope, offset = _linear_argument(argument, variable, f)
+        if slope == 0:
+            raise UnsupportedNonlinearityError(f"f = {f}: a switch whose argument does not depend on u; {_SUPPORTED}")
+        breakpoints.append(-offset / slope)
+        slopes.append(slope)
+    unique: list[sympy.Expr] = []
+    for point in breakpoints:
+        if not any(sympy.simplify(point - other) == 0 for other in unique):
+            unique.append(point)
+    try:
+        unique.sort(key=lambda point: point if point.is_number else sympy.nan)
+        for left, right in zip(unique, unique[1:]):
+            if (right - left).is_positive is not True:
+                raise TypeError
+    except TypeError:
+        raise UnsupportedNonlinearityError(
+            f"f = {f}: cannot order the breakpoints {unique}; give numeric gaps when there are several springs"
+        ) from None
+
+    def test_point(index: int) -> sympy.Expr:
+        if not unique:
+            return sympy.Integer(0)
+        if index == 0:
+            return unique[0] - 1
+        if index == len(unique):
+            return unique[-1] + 1
+        return (unique[index - 1] + unique[index]) / 2
+
+    intervals: list[LinearInterval] = []
+    for index in range(len(unique) + 1):
+        point = test_point(index)
+        replacements = {}
+        for (atom, argument), slope in zip(switching, slopes):
+            sign_value = sympy.sign(sympy.simplify(argument.subs(variable, point)))
+            if sign_value not in (1, -1):
+                raise UnsupportedNonlinearityError(f"f = {f}: cannot decide the sign of {argument} between breakpoints")
+            replacements[atom] = _branch_value(atom, int(sign_value))
+        piece = sympy.expand(f.xreplace(replacements))
+        if piece.has(*_SWITCHING) or not piece.is_polynomial(variable) or sympy.degree(piece, variable) > 1:
+            raise UnsupportedNonlinearityError(f"f = {f} is not piecewise linear in u (piece {piece}); {_SUPPORTED}")
+        slope = piece.coeff(variable, 1)
+        intercept = piece.coeff(variable, 0)
+        lower = unique[index - 1] if index > 0 else None
+        upper = unique[index] if index < len(unique) else None
+        intervals.append(LinearInterval(lower, upper, sympy.simplify(slope), sympy.simplify(intercept)))
+    for left, right in zip(intervals, intervals[1:]):
+        point = left.upper
+        jump = sympy.simplify((right.slope - left.slope) * point + right.intercept - left.intercept)
+        if jump != 0:
+            raise UnsupportedNonlinearityError(
+                f"f = {f} jumps by {jump} at u = {point}: a discontinuous force (e.g. a bare Heaviside) "
+                f"is not supported; {_SUPPORTED}"
+            )
+    return intervals
