@@ -209,7 +209,7 @@ def _chebyshev_cosine_series(function: Callable, domain: Any, digits: int, toler
                     if not mpmath.isfinite(exact) or abs(value - exact) > 1000 * tolerance * max(scale, abs(exact)):
                         break
                 else:
-                    kept = {n: domain.convert(c) for n, c in enumerate(coefficients) if abs(c) > tolerance * scale}
+                    kept = {n: domain.from_sympy(sympy.Float(c, digits + 10)) for n, c in enumerate(coefficients) if abs(c) > tolerance * scale}
                     return CosineSeries(domain, kept)
             nodes *= 2
     raise UnsupportedNonlinearityError(

@@ -224,10 +224,10 @@ def piecewise_normal_form(problem: Oscillator, digits: int | None = None) -> Pie
         boundaries.append(ContactBoundary(kappa, angle, point, kappa_element, sine_element))
     zero = EvaluationPoint(domain, domain.zero, domain.one, domain.zero)
     pi_point = EvaluationPoint(domain, field.convert(sympy.pi), -domain.one, domain.zero)
-    if all(not ell and not m for ell, m in piece_coefficients):
-        regime = "no contact"
-    elif grazing:
+    if grazing:
         regime = "grazing"
+    elif all(not ell and not m for ell, m in piece_coefficients):
+        regime = "no contact"
     else:
         regime = "contact"
     validity = sympy.Rational(-1, 2) if grazing else sympy.Integer(-1)
