@@ -112,7 +112,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except LindstedtError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
-    print(output)
+    try:
+        print(output)
+    except BrokenPipeError:  # e.g. `lindstedt expand ... | head`
+        sys.stderr.close()
     return 0
 
 
