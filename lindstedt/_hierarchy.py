@@ -398,19 +398,25 @@ class LindstedtPoincare:
             raise ProblemError("precision must be an integer number of decimal digits between 15 and 1000")
         self.precision = precision
         self.numeric = bool(numeric)
-        self._hierarchies: dict[Oscillator, SmoothHierarchy] = {}
+        self._hierarchies: dict[Any, Any] = {}
 
-    def hierarchy(self, problem: Oscillator):
-        """The (cached) normalised hierarchy of ``problem`` (smooth or piecewise-linear)."""
+    def hierarchy(self, problem: Oscillator, order: int = 4):
+        """The (cached) normalised hierarchy of ``problem`` (smooth or piecewise-linear).
+
+        ``order`` is the highest order that will be asked for; float hierarchies
+        of piecewise problems near grazing add guard digits for it.
+        """
+        if problem.is_non_smooth:
+            from ._piecewise_hierarchy import PiecewiseHierarchy, piecewise_normal_form
+
+            digits = self.precision if self.numeric else None
+            form = piecewise_normal_form(problem, digits, order_hint=order + 1)
+            key = (problem, form.domain)
+            if key not in self._hierarchies:
+                self._hierarchies[key] = PiecewiseHierarchy(form, problem.normalization)
+            return self._hierarchies[key]
         if problem not in self._hierarchies:
-            if problem.is_non_smooth:
-                from ._piecewise_hierarchy import PiecewiseHierarchy, piecewise_normal_form
-
-                digits = self.precision if self.numeric else None
-                hierarchy = PiecewiseHierarchy(piecewise_normal_form(problem, digits), problem.normalization)
-            else:
-                hierarchy = SmoothHierarchy(normal_form(problem, self.precision), problem.normalization)
-            self._hierarchies[problem] = hierarchy
+            self._hierarchies[problem] = SmoothHierarchy(normal_form(problem, self.precision), problem.normalization)
         return self._hierarchies[problem]
 
     def expand(self, problem: Oscillator, order: int):
@@ -424,7 +430,7 @@ class LindstedtPoincare:
         from ._expansion import Expansion
 
         validate_order(order)
-        return Expansion(problem=problem, order=order, _hierarchy=self.hierarchy(problem))
+        return Expansion(problem=problem, order=order, _hierarchy=self.hierarchy(problem, order))
 
 
 def validate_order(order: Any) -> int:

@@ -37,6 +37,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+import mpmath
 import sympy
 from sympy import QQ, RealField
 
@@ -153,11 +154,32 @@ def _compare(value: sympy.Expr, bound: int) -> int | None:
     return None
 
 
-def piecewise_normal_form(problem: Oscillator, digits: int | None = None) -> PiecewiseNormalForm:
+def _guard_digits(kappas: list[sympy.Expr], order: int) -> int:
+    """Extra working digits for a float hierarchy near grazing.
+
+    Near |κ| = 1 the contact angle margin m = min(β, π − β) is small and the
+    order-k corrections are O(m^{2k+1}) differences of O(1) terms, so about
+    (2k + 3)·log10(1/m) digits cancel; they are added to the working precision.
+    """
+    margin = mpmath.mpf(1)
+    with mpmath.workdps(50):
+        for kappa in kappas:
+            if not kappa.is_number:
+                continue
+            angle = mpmath.acos(mpmath.mpf(sympy.N(kappa, 60)))
+            margin = min(margin, angle, mpmath.pi - angle)
+        if margin <= 0:
+            return 0
+        return int(mpmath.ceil((2 * order + 5) * max(0, -mpmath.log10(margin))))
+
+
+def piecewise_normal_form(problem: Oscillator, digits: int | None = None, order_hint: int = 4) -> PiecewiseNormalForm:
     """Build the normalised piecewise problem.
 
     ``digits`` selects a numeric ``RealField`` (also chosen automatically when
-    the inputs contain floats); otherwise the hierarchy is exact.
+    the inputs contain floats); otherwise the hierarchy is exact.  In the
+    numeric case guard digits are added near grazing (see :func:`_guard_digits`)
+    so that ``digits`` stay correct up to order ``order_hint``.
     """
     intervals = decompose_piecewise_linear(problem.nonlinearity, DISPLACEMENT)
     amplitude = problem.a0
@@ -209,6 +231,9 @@ def piecewise_normal_form(problem: Oscillator, digits: int | None = None) -> Pie
         values += [slope, intercept]
     for kappa in crossing_kappas:
         values += [kappa, sympy.acos(kappa), sympy.sqrt(1 - kappa**2)]
+    numeric = digits is not None or any(value.has(sympy.Float) for value in values)
+    if numeric:
+        digits = (digits or 30) + _guard_digits(crossing_kappas, order_hint)
     field = _ConstantField(values, digits)
     domain = field.domain
     piece_coefficients = []
