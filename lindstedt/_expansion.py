@@ -451,7 +451,11 @@ class Expansion:
         equation = (
             r"\ddot u + " + _latex(problem.omega0**2) + r" u + \varepsilon\left(" + _latex(problem.f.subs(problem.variable, u)) + r"\right) = 0"
         )
-        lines = [equation + r",\quad u(0) = " + (_latex(problem.a0) if problem.normalization == "initial" else r"\dots")]
+        if problem.normalization == "initial":
+            condition = r"u(0) = " + _latex(problem.a0) + r",\ \dot u(0) = 0"
+        else:
+            condition = r"\dot u(0) = 0,\ " + _latex(problem.a0) + r" = \text{first-harmonic amplitude}"
+        lines = [r"& " + equation + r",\quad " + condition]
         for k, value in enumerate(self.omega):
             lines.append(rf"\omega_{{{k}}} &= {_latex(value)}")
         lines.append(r"\omega(\varepsilon) &= " + _latex(self.frequency_expr()) + rf" + O(\varepsilon^{{{self.order + 1}}})")
