@@ -10,6 +10,7 @@ Examples
 """
 
 from ._api import expand
+from ._codegen import GeneratedCode, generate_code
 from ._cosine import CosineSeries, SineSeries, solve_harmonic_oscillator
 from ._errors import (
     ConvergenceError,
@@ -20,7 +21,7 @@ from ._errors import (
     ResonanceError,
     UnsupportedNonlinearityError,
 )
-from ._expansion import Expansion, Waveform
+from ._expansion import Expansion, PiecewiseWaveform, Waveform
 from ._hierarchy import LindstedtPoincare
 from ._problem import Oscillator
 
@@ -32,6 +33,9 @@ __all__ = [
     "LindstedtPoincare",
     "Expansion",
     "Waveform",
+    "PiecewiseWaveform",
+    "generate_code",
+    "GeneratedCode",
     "CosineSeries",
     "SineSeries",
     "solve_harmonic_oscillator",

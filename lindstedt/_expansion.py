@@ -412,9 +412,24 @@ class Expansion:
         return sympy.Add(*[self.omega_correction(k) * EPSILON**k for k in range(order + 1)])
 
     def displacement_expr(self) -> sympy.Expr:
-        """u(t; ε) = Σ_{k≤N} ε^k v_k(ω t) with ω through ω_{N+1}, as a sympy expression."""
+        """u(t; ε) = Σ_{k≤N} ε^k v_k(ω t) with ω through ω_{N+1}, as a sympy expression.
+
+        For piecewise-linear f the strained time is folded to [0, π]
+        (evenness, 2π-periodicity) and the pieces end at the moving contact
+        angles s_i*(ε) = β_i + Σ_{k≤N} σ_{i,k} ε^k, as in :meth:`displacement`.
+        """
         frequency = self.frequency_expr(self.order + 1)
-        return sympy.Add(*[EPSILON**w.order * w.to_expr(frequency * TIME) for w in self.waveforms])
+        if not self.is_piecewise:
+            return sympy.Add(*[EPSILON**w.order * w.to_expr(frequency * TIME) for w in self.waveforms])
+        folded = sympy.Abs(sympy.Mod(frequency * TIME + sympy.pi, 2 * sympy.pi) - sympy.pi)
+        pieces = [sympy.Add(*[EPSILON**w.order * w.branches[p] for w in self.waveforms]) for p in range(len(self.waveforms[0].branches))]
+        boundaries = [
+            sympy.Add(*[EPSILON**k * self.contact_angle_correction(k)[index] for k in range(1, self.order + 1)], angle)
+            for index, angle in enumerate(self.contact_angles)
+        ]
+        conditions = [(piece.subs(STRAINED_TIME, folded), folded <= boundary) for piece, boundary in zip(pieces, boundaries)]
+        conditions.append((pieces[-1].subs(STRAINED_TIME, folded), True))
+        return sympy.Piecewise(*conditions)
 
     @property
     def arguments(self) -> tuple[sympy.Symbol, ...]:
