@@ -6,7 +6,10 @@ Two quantities can be generated for any :class:`~lindstedt.Expansion`:
     ω(ε; parameters) = Σ_{k≤N} ω_k ε^k, vectorised over ε;
 ``"displacement"``
     u(t; ε, parameters) = Σ_{k≤N} ε^k v_k(ω t) (frequency through ω_{N+1}),
-    vectorised over t.
+    vectorised over t;
+``"omega<k>"`` (e.g. ``"omega2"``)
+    the coefficient ω_k(parameters) alone, vectorised over the first free
+    symbol (e.g. ω_2(κ) over an array of gaps).
 
 The expression is reduced by common-subexpression elimination (``sympy.cse``)
 and printed by ``NumPyPrinter`` or ``C99CodePrinter``.  C code is a loop over
@@ -115,7 +118,7 @@ def generate_code(expansion: Any, quantity: str = "frequency", language: str = "
     Parameters
     ----------
     expansion : Expansion
-    quantity : {"frequency", "displacement"}
+    quantity : {"frequency", "displacement", "omega<k>"}
     language : {"numpy", "c"}
 
     Returns
@@ -131,15 +134,23 @@ def generate_code(expansion: Any, quantity: str = "frequency", language: str = "
     >>> code.arguments
     ('epsilon', 'a0', 'omega0')
     """
-    if quantity not in _QUANTITIES:
-        raise ValueError(f"quantity must be one of {_QUANTITIES}")
+    coefficient = _coefficient_index(quantity)
+    if quantity not in _QUANTITIES and coefficient is None:
+        raise ValueError(f"quantity must be one of {_QUANTITIES} or 'omega<k>' (e.g. 'omega2')")
     if language not in _LANGUAGES:
         raise ValueError(f"language must be one of {_LANGUAGES}")
     from ._expansion import EPSILON, TIME
 
     parameters = list(expansion.arguments)
-    if quantity == "frequency":
-        vector, expression = EPSILON, expansion.frequency_expr()
+    if coefficient is not None:
+        if not parameters:
+            raise ValueError(f"{quantity} of this expansion is a constant ({expansion.omega_correction(coefficient)}); nothing to vectorise")
+        # A single coefficient is worth simplifying once (e.g. ω_2(κ) shrinks several-fold).
+        vector = parameters[0]
+        expression = _horner_form(sympy.simplify(expansion.omega_correction(coefficient)), vector)
+        arguments = parameters
+    elif quantity == "frequency":
+        vector, expression = EPSILON, _horner_form(expansion.frequency_expr(), EPSILON)
         arguments = [EPSILON, *parameters]
     else:
         vector, expression = TIME, expansion.displacement_expr()
@@ -152,6 +163,42 @@ def generate_code(expansion: Any, quantity: str = "frequency", language: str = "
     else:
         source = _c_source(name, arguments, vector, expression)
     return GeneratedCode(language, quantity, name, tuple(str(a) for a in arguments), source)
+
+
+def _horner_form(expression: sympy.Expr, variable: sympy.Symbol) -> sympy.Expr:
+    """Horner scheme in ``variable`` and in the transcendental atoms that depend on it.
+
+    ω_k(κ) is a polynomial in κ, acos κ and sqrt(1 − κ²) over a constant
+    denominator; nesting it (Horner) halves the operation count and avoids
+    slow general powers in vectorised code.  Anything else is returned as is.
+    """
+    atoms = sorted(
+        (
+            atom
+            for atom in expression.atoms(sympy.Function, sympy.Pow)
+            if atom.has(variable) and not (isinstance(atom, sympy.Pow) and atom.exp.is_Integer)
+        ),
+        key=sympy.default_sort_key,
+    )
+    placeholders = [sympy.Dummy(f"atom{index}") for index in range(len(atoms))]
+    replaced = expression.xreplace(dict(zip(atoms, placeholders)))
+    if any(other.has(variable) for other in placeholders) or replaced.has(*atoms):
+        return expression
+    numerator, denominator = sympy.fraction(sympy.together(replaced))
+    generators = [variable, *placeholders]
+    try:
+        if denominator.has(*generators):
+            return expression
+        nested = sympy.horner(sympy.Poly(sympy.expand(numerator), *generators)) / denominator
+    except sympy.PolynomialError:
+        return expression
+    return nested.xreplace(dict(zip(placeholders, atoms)))
+
+
+def _coefficient_index(quantity: str) -> int | None:
+    if quantity.startswith("omega") and quantity[5:].isdigit():
+        return int(quantity[5:])
+    return None
 
 
 def _compile_c(code: GeneratedCode) -> Callable[..., np.ndarray]:
