@@ -22,14 +22,23 @@ from ._errors import (
     UnsupportedNonlinearityError,
 )
 from ._expansion import Expansion, PiecewiseWaveform, Waveform
+from ._flow import ExactFlow
 from ._hierarchy import LindstedtPoincare
+from ._nnm_expansion import NNMExpansion, StrainedCoordinatesNNM, nnm
 from ._problem import Oscillator
+from ._system import Modes, UnilateralSystem
 
 __version__ = "0.1.0"
 
 __all__ = [
     "expand",
+    "nnm",
     "Oscillator",
+    "UnilateralSystem",
+    "Modes",
+    "StrainedCoordinatesNNM",
+    "NNMExpansion",
+    "ExactFlow",
     "LindstedtPoincare",
     "Expansion",
     "Waveform",

@@ -73,6 +73,41 @@ def _oscillator_inverse(key: TermKey) -> _RationalTerms:
     return tuple((k, v) for k, v in result.items() if v)
 
 
+def _general_oscillator_inverse(key: tuple, frequency: Any, domain: Any, memo: dict) -> dict:
+    """Particular solution of v'' + r² v = s^m trig(ν s) with domain coefficients (r = frequency).
+
+    Non-resonant ν ≠ r:  L[s^m c(νs)] = (r² − ν²) s^m c(νs) + m(m−1) s^{m−2} c(νs) ∓ 2νm s^{m−1} c'(νs).
+    Resonant ν = r:      top term ± s^{m+1} (sin|cos)(rs) / (2r(m+1)), residual ± (m/(2r)) s^{m−1} (sin|cos)(rs).
+    """
+    if key in memo:
+        return memo[key]
+    harmonic, parity, power = key
+    result: dict = {}
+    if harmonic == frequency:
+        top = (harmonic, 1 - parity, power + 1)
+        sign = 1 if parity == 0 else -1
+        scale = domain.one / (domain.convert(2 * (power + 1)) * frequency)
+        _add_into(result, top, scale * domain.convert(sign))
+        if power >= 1:
+            residual = domain.convert(sign * power) / (domain.convert(2) * frequency)
+            for sub_key, value in _general_oscillator_inverse((harmonic, 1 - parity, power - 1), frequency, domain, memo).items():
+                _add_into(result, sub_key, -residual * value)
+    else:
+        factor = domain.one / (frequency * frequency - harmonic * harmonic)
+        _add_into(result, key, factor)
+        residuals = []
+        if power >= 2:
+            residuals.append(((harmonic, parity, power - 2), domain.convert(power * (power - 1))))
+        if power >= 1 and harmonic:
+            sign = -1 if parity == 0 else 1
+            residuals.append(((harmonic, 1 - parity, power - 1), domain.convert(sign * 2 * power) * harmonic))
+        for residual_key, coefficient in residuals:
+            for sub_key, value in _general_oscillator_inverse(residual_key, frequency, domain, memo).items():
+                _add_into(result, sub_key, -factor * coefficient * value)
+    memo[key] = {k: v for k, v in result.items() if v}
+    return memo[key]
+
+
 @lru_cache(maxsize=None)
 def _antiderivative(key: TermKey) -> _RationalTerms:
     """An antiderivative over QQ of s^m trig_j(s) (integration by parts)."""
@@ -114,6 +149,7 @@ class EvaluationPoint:
         self._cos = [domain.one, cosine]
         self._sin = [domain.zero, sine]
         self._powers = [domain.one]
+        self._cache: dict[Any, tuple[Any, Any]] = {}
 
     def power(self, exponent: int) -> Any:
         """s0 ** exponent."""
@@ -128,15 +164,29 @@ class EvaluationPoint:
             self._cos.append(two_cos * self._cos[-1] - self._cos[-2])
             self._sin.append(two_cos * self._sin[-1] - self._sin[-2])
 
-    def cos_multiple(self, harmonic: int) -> Any:
-        """cos(harmonic · s0)."""
-        self._extend(harmonic)
-        return self._cos[harmonic]
+    def cos_multiple(self, harmonic: Any) -> Any:
+        """cos(harmonic · s0); a non-integer frequency needs a float domain (RealField)."""
+        if isinstance(harmonic, int):
+            self._extend(harmonic)
+            return self._cos[harmonic]
+        return self._transcendental(harmonic)[0]
 
-    def sin_multiple(self, harmonic: int) -> Any:
-        """sin(harmonic · s0)."""
-        self._extend(harmonic)
-        return self._sin[harmonic]
+    def sin_multiple(self, harmonic: Any) -> Any:
+        """sin(harmonic · s0); a non-integer frequency needs a float domain (RealField)."""
+        if isinstance(harmonic, int):
+            self._extend(harmonic)
+            return self._sin[harmonic]
+        return self._transcendental(harmonic)[1]
+
+    def _transcendental(self, frequency: Any) -> tuple[Any, Any]:
+        context = getattr(self.value, "context", None)
+        if context is None:
+            raise TypeError("non-integer frequencies can only be evaluated in a float (RealField) domain")
+        key = ("frequency", frequency)
+        if key not in self._cache:
+            argument = frequency * self.value
+            self._cache[key] = (context.cos(argument), context.sin(argument))
+        return self._cache[key]
 
 
 class Branch:
@@ -207,8 +257,8 @@ class Branch:
             if power:
                 _add_into(result, (harmonic, parity, power - 1), value * convert(power))
             if harmonic:
-                sign = -1 if parity == 0 else 1
-                _add_into(result, (harmonic, 1 - parity, power), value * convert(sign * harmonic))
+                factor = convert(harmonic) if isinstance(harmonic, int) else harmonic
+                _add_into(result, (harmonic, 1 - parity, power), value * factor if parity else -(value * factor))
         return Branch(self.domain, result)
 
     def times_cosine(self, harmonic: int) -> "Branch":
@@ -225,11 +275,24 @@ class Branch:
                 _add_into(result, (-difference, parity, power), half_value if parity == 0 else -half_value)
         return Branch(self.domain, result)
 
-    def oscillator_particular_solution(self) -> "Branch":
-        """A particular solution of ``v'' + v = self`` (resonant j = 1 handled)."""
+    def oscillator_particular_solution(self, frequency: Any = None) -> "Branch":
+        """A particular solution of ``v'' + r² v = self`` (r = ``frequency``, default 1).
+
+        Forcing at the resonant frequency ν = r raises the power of s (secular growth
+        on a bounded piece is fine: the pieces are joined by matching conditions).
+        """
         result: dict[TermKey, Any] = {}
+        unit = frequency is None or (isinstance(frequency, int) and frequency == 1)
+        if unit and all(isinstance(key[0], int) for key in self.terms):
+            for key, value in self.terms.items():
+                self._from_rational(_oscillator_inverse(key), value, result)
+            return Branch(self.domain, result)
+        if unit:
+            frequency = self.domain.one
+        memo: dict[TermKey, dict[TermKey, Any]] = {}
         for key, value in self.terms.items():
-            self._from_rational(_oscillator_inverse(key), value, result)
+            for sub_key, sub_value in _general_oscillator_inverse(key, frequency, self.domain, memo).items():
+                _add_into(result, sub_key, value * sub_value)
         return Branch(self.domain, result)
 
     def antiderivative(self) -> "Branch":

@@ -5,6 +5,8 @@ Sub-commands
 ``lindstedt expand F --order N [--a0 A] [--omega0 W] [--param NAME=VALUE ...]
 [--normalization initial|harmonic] [--format text|latex|json]``
     Lindstedt–Poincaré expansion of the oscillator with nonlinearity F.
+``lindstedt nnm SYSTEM.json --mode J --a0 A [--order 2] [--format text|latex|json]``
+    Nonlinear normal mode of M X'' + K X + ε W (A X − b)_+ = 0 grown from mode J.
 ``lindstedt demo``
     The tour: derives the Duffing and unilateral-spring expansions, prints them
     and their agreement with the exact references.
@@ -59,6 +61,14 @@ def build_parser() -> argparse.ArgumentParser:
     expand.add_argument("--waveforms", action="store_true", help="include the waveforms v_k in text/LaTeX output")
     expand.add_argument("--precision", type=int, default=30, help="decimal digits for non-polynomial f (default 30)")
 
+    nnm = commands.add_parser("nnm", help="nonlinear normal mode of M X'' + K X + eps W (A X - b)_+ = 0 by strained coordinates")
+    nnm.add_argument("system", help="SYSTEM.json with keys M, K, A, b and optional W (nested lists, numbers or exact strings)")
+    nnm.add_argument("--mode", type=int, required=True, help="mode number j (1-based, increasing frequency)")
+    nnm.add_argument("--a0", required=True, help="modal amplitude of mode j at release")
+    nnm.add_argument("--order", type=int, default=2, help="expansion order (default 2)")
+    nnm.add_argument("--precision", type=int, default=30, help="decimal digits of the arithmetic (default 30)")
+    nnm.add_argument("--format", choices=("text", "latex", "json"), default="text")
+
     demo = commands.add_parser("demo", help="the tour: Duffing and u_+ expansions checked against exact references")
     demo.add_argument("--order", type=int, default=8, help="Duffing order to derive (default 8)")
     return parser
@@ -86,6 +96,28 @@ def _command_expand(arguments: argparse.Namespace) -> str:
     return text
 
 
+def _command_nnm(arguments: argparse.Namespace) -> str:
+    import json
+
+    from ._errors import ProblemError
+    from ._nnm_expansion import nnm
+    from ._parsing import parse_number
+    from ._system import UnilateralSystem
+
+    try:
+        with open(arguments.system, encoding="utf-8") as handle:
+            data = json.load(handle)
+    except (OSError, json.JSONDecodeError) as error:
+        raise ProblemError(f"cannot read the system file {arguments.system!r}: {error}") from None
+    system = UnilateralSystem.from_json_dict(data)
+    result = nnm(system, arguments.mode, parse_number(arguments.a0, what="a0"), arguments.order, precision=arguments.precision)
+    if arguments.format == "json":
+        return result.to_json()
+    if arguments.format == "latex":
+        return result.to_latex()
+    return result.summary()
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status.
 
@@ -102,6 +134,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if arguments.command == "expand":
             output = _command_expand(arguments)
+        elif arguments.command == "nnm":
+            output = _command_nnm(arguments)
         elif arguments.command == "demo":
             from ._demo import run_demo
 

@@ -1,0 +1,183 @@
+"""NNM by strained coordinates (Theorem 4.1 derived) against numerical NNMs from shooting on the exact flow."""
+
+import json
+
+import mpmath
+import numpy as np
+import pytest
+from scipy.optimize import root
+
+import lindstedt
+from lindstedt import ProblemError, ResonanceError, UnilateralSystem
+from lindstedt._cli import main
+from lindstedt._contact_fourier import contact_ramp_coefficient_mp, series_sum
+from lindstedt._flow import ExactFlow
+
+EPSILONS = np.geomspace(0.0005, 0.004, 8)  # in units of λ_j² (the small parameter is ε/λ_j²)
+
+
+def numerical_nnm(system, mode, a0, epsilon, guess_others, guess_period):
+    """Periodic orbit released from rest with modal amplitude a0 of `mode`: X'(T/2) = 0 (time-reversal symmetry)."""
+    shapes = system.modes().shapes
+    size = system.n_dof
+    others = [k for k in range(size) if k != mode]
+    flow = ExactFlow(system, epsilon)
+
+    def residual(unknowns):
+        modal = np.zeros(size)
+        modal[mode] = a0
+        modal[others] = unknowns[:-1]
+        return flow.flow_map(shapes @ modal, np.zeros(size), unknowns[-1] / 2).velocity
+
+    solution = root(residual, np.r_[guess_others, guess_period], method="hybr", tol=1e-15)
+    assert np.max(np.abs(residual(solution.x))) < 1e-11
+    return 2 * np.pi / solution.x[-1], solution.x[:-1]
+
+
+def check_against_shooting(system, mode, a0=1.0):
+    expansion = lindstedt.nnm(system, mode=mode + 1, a0=a0, order=2)
+    omega = np.array([float(value) for value in expansion.omega])
+    a_k = np.array([float(value) for value in expansion.a_k])
+    # the natural small parameter is ε/λ_j² (the stiffness ratio): scale the grid with it
+    epsilons = EPSILONS * omega[0] ** 2
+    frequencies, others = [], []
+    for epsilon in epsilons:
+        frequency, modal = numerical_nnm(system, mode, a0, epsilon, epsilon * a_k, 2 * np.pi / (omega[0] + epsilon * omega[1]))
+        frequencies.append(frequency)
+        others.append(modal / epsilon)
+    frequencies = np.array(frequencies)
+    # fit ω(ε) − λ_j = ω1 ε + ω2 ε² + c3 ε³ + … + c5 ε⁵ over the small ε
+    design = np.vstack([epsilons**power for power in range(1, 6)]).T
+    fitted = np.linalg.lstsq(design, frequencies - omega[0], rcond=None)[0]
+    # compared in the dimensionless form Ω_n = ω_n λ_j^(2n−1) (ε/λ_j² is the small parameter)
+    for n in (1, 2):
+        scale = omega[0] ** (2 * n - 1)
+        assert fitted[n - 1] * scale == pytest.approx(omega[n] * scale, abs=1e-6)
+    residuals = np.abs(frequencies - (omega[0] + omega[1] * epsilons + omega[2] * epsilons**2))
+    slope = np.polyfit(np.log(epsilons), np.log(residuals), 1)[0]
+    assert slope == pytest.approx(3, abs=0.25)
+    # q_k(ε)/ε = a_k + b_k ε + O(ε²): linear extrapolation from two tiny ε (b_k can be large)
+    ratios = []
+    for epsilon in (1e-5 * omega[0] ** 2, 2e-5 * omega[0] ** 2):
+        _, modal = numerical_nnm(system, mode, a0, epsilon, epsilon * a_k, 2 * np.pi / omega[0])
+        ratios.append(modal / epsilon)
+    intercepts = 2 * ratios[0] - ratios[1]
+    assert np.max(np.abs(intercepts - a_k)) < 1e-6 * max(1.0, np.max(np.abs(a_k)))
+
+
+@pytest.mark.parametrize(
+    "size, springs",
+    [
+        (2, [(0, 0.0)]),
+        (2, [(1, 0.3)]),
+        (3, [(0, 0.2), (2, -0.1)]),
+        (5, [(0, 0.0), (3, -0.2)]),
+    ],
+)
+def test_chain_every_mode_matches_shooting(size, springs):
+    system = UnilateralSystem.chain(size, unilateral=springs)
+    for mode in range(size):
+        check_against_shooting(system, mode)
+
+
+@pytest.mark.slow
+def test_twenty_masses_every_mode_matches_shooting():
+    system = UnilateralSystem.chain(20, unilateral=[(0, 0.1), (10, -0.05), (19, 0.0)])
+    for mode in range(20):
+        check_against_shooting(system, mode)
+
+
+def test_twenty_masses_two_modes_match_shooting():
+    system = UnilateralSystem.chain(20, unilateral=[(0, 0.1), (10, -0.05), (19, 0.0)])
+    for mode in (0, 19):
+        check_against_shooting(system, mode)
+
+
+@pytest.mark.parametrize("stiffness, gap, release, omega0", [(1, 0, 1, 1), ("17/10", "3/10", "13/10", "11/10"), (2, "-1/4", "-3/5", "1/2")])
+def test_one_dof_limit_reproduces_the_scalar_engine(stiffness, gap, release, omega0):
+    system = UnilateralSystem(M=[[1]], K=[[f"({omega0})**2" if isinstance(omega0, str) else omega0**2]], A=[[1]], b=[gap], W=[[stiffness]])
+    result = lindstedt.nnm(system, mode=1, a0=release, order=3)
+    scalar = lindstedt.expand(f"({stiffness})*Max(0, u - ({gap}))", order=3, a0=release, omega0=omega0, numeric=True)
+    for ours, theirs in zip(result.omega, scalar.omega):
+        assert float(ours) == pytest.approx(float(theirs), rel=1e-20, abs=1e-25)
+
+
+def test_a_k_matches_the_fourier_series_of_corollary_4_2():
+    # zero gap, one spring: v_k^1 solves λ_j² v'' + λ_k² v = −G_k (a0 B_j cos s)_+; a_k = v_k^1(0) = Σ_l F_l / (λ_k² − l² λ_j²)
+    system = UnilateralSystem.chain(3, unilateral=[(0, 0.0)])
+    frequencies, shapes = system.modes()
+    mode, amplitude = 1, 0.8
+    result = lindstedt.nnm(system, mode=mode + 1, a0=amplitude, order=1)
+    coupling = amplitude * shapes[0, mode]  # a0 B_1j with A = e_1ᵀ
+    for k in (0, 2):
+        force = shapes[0, k]  # G_k1 = Φ_1k (W = Aᵀ)
+        with mpmath.workdps(30):
+            def term(harmonic, k=k, force=force):
+                # (c cos s)_+ = |c| (±cos s)_+ : coefficient of cos(l s) is |c| (±1)^l c_l[0]
+                sign = 1 if coupling > 0 else (-1) ** int(harmonic)
+                coefficient = -force * abs(coupling) * sign * contact_ramp_coefficient_mp(int(harmonic), 0, dps=30)
+                return coefficient / (frequencies[k] ** 2 - harmonic**2 * frequencies[mode] ** 2)
+
+            value, error = series_sum(term, start=0, dps=30)
+        assert float(value) == pytest.approx(float(result.release_modal[k]), rel=1e-12)
+
+
+def test_internal_resonance_raises_and_near_resonance_is_reported():
+    resonant = UnilateralSystem(M=[[1, 0], [0, 1]], K=[[1, 0], [0, 4]], A=[[1, 1]], b=[0])
+    with pytest.raises(ResonanceError, match="harmonic 2"):
+        lindstedt.nnm(resonant, mode=1, a0=1)
+    assert len(lindstedt.nnm(resonant, mode=2, a0=1).omega) == 3  # mode 2: λ1/λ2 = 1/2 is not an integer
+    near = UnilateralSystem(M=[[1, 0], [0, 1]], K=[[1, 0], [0, "4.00004"]], A=[[1, 1]], b=["1/10"])
+    result = lindstedt.nnm(near, mode=1, a0=1)
+    (mode, harmonic, divisor), = result.small_divisors
+    assert (mode, harmonic) == (2, 2) and divisor == pytest.approx(4e-5, rel=1e-3)
+    reference = lindstedt.nnm(near, mode=1, a0=1, precision=60)
+    for ours, accurate in zip(result.omega, reference.omega):
+        assert abs(float(ours) - float(accurate)) <= 1e-12 * max(1.0, abs(float(accurate)))
+
+
+def test_validity_reports_root_multiplicity():
+    system = UnilateralSystem.chain(2, unilateral=[(0, 0.1)])
+    shapes = system.modes().shapes
+    simple = lindstedt.nnm(system, mode=1, a0=1)
+    assert simple.spring_roots == ("simple",) and simple.validity_exponent == -1
+    grazing_amplitude = 0.1 / shapes[0, 0]
+    grazing = lindstedt.nnm(system, mode=1, a0=grazing_amplitude)
+    assert grazing.spring_roots == ("double",) and str(grazing.validity_exponent) == "-1/2"
+    free = lindstedt.nnm(system, mode=1, a0=grazing_amplitude / 2)
+    assert free.spring_roots == ("none",)
+    assert [float(value) for value in free.omega[1:]] == [0.0, 0.0]
+
+
+def test_json_and_cli(tmp_path, capsys):
+    path = tmp_path / "system.json"
+    path.write_text(json.dumps({"M": [[1, 0], [0, 1]], "K": [[2, -1], [-1, 2]], "A": [[1, 0]], "b": ["1/10"]}))
+    assert main(["nnm", str(path), "--mode", "1", "--a0", "1", "--format", "json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert set(data) >= {"lambda", "omega", "a_k", "validity"}
+    assert data["lambda"] == pytest.approx([1.0, 3**0.5], rel=1e-15)
+    assert len(data["omega"]) == 3 and len(data["a_k"]) == 1
+    assert main(["nnm", str(path), "--mode", "3", "--a0", "1"]) == 2
+    assert "mode must be" in capsys.readouterr().err
+    assert main(["nnm", str(tmp_path / "missing.json"), "--mode", "1", "--a0", "1"]) == 2
+
+
+@pytest.mark.parametrize(
+    "kwargs, fragment",
+    [
+        ({"M": [[1, 2], [0, 1]], "K": [[1, 0], [0, 1]], "A": [[1, 0]], "b": [0]}, "symmetric"),
+        ({"M": [[1, 0], [0, 1]], "K": [[1, 0], [0, -1]], "A": [[1, 0]], "b": [0]}, "positive definite"),
+        ({"M": [[1, 0], [0, 1]], "K": [[1, 0], [0, 2]], "A": [[1, 0, 0]], "b": [0]}, "A"),
+    ],
+)
+def test_bad_systems_raise_typed_errors(kwargs, fragment):
+    with pytest.raises(ProblemError, match=fragment):
+        UnilateralSystem(**kwargs)
+
+
+def test_bad_nnm_arguments():
+    system = UnilateralSystem.chain(2, unilateral=[(0, 0)])
+    with pytest.raises(ProblemError, match="mode"):
+        lindstedt.nnm(system, mode=0, a0=1)
+    with pytest.raises(ProblemError, match="a0 = 0"):
+        lindstedt.nnm(system, mode=1, a0=0)
