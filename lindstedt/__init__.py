@@ -9,6 +9,7 @@ Examples
 (1, 3/8, -21/256)
 """
 
+from ._all_modes import AllModesFirstOrder, all_modes_first_order
 from ._api import expand
 from ._codegen import GeneratedCode, generate_code
 from ._cosine import CosineSeries, SineSeries, solve_harmonic_oscillator
@@ -33,6 +34,8 @@ __version__ = "0.1.0"
 __all__ = [
     "expand",
     "nnm",
+    "all_modes_first_order",
+    "AllModesFirstOrder",
     "Oscillator",
     "UnilateralSystem",
     "Modes",
