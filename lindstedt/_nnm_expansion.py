@@ -51,7 +51,7 @@ from ._branch import Branch, EvaluationPoint
 from ._errors import ProblemError, ResonanceError
 from ._system import UnilateralSystem
 
-__all__ = ["NNMExpansion", "StrainedCoordinatesNNM", "nnm"]
+__all__ = ["NNMExpansion", "StrainedCoordinatesNNM", "nnm", "release_amplitudes_by_series"]
 
 _RESONANCE_TOLERANCE = 1e-9
 _GRAZING_TOLERANCE = 1e-12
@@ -644,6 +644,51 @@ class StrainedCoordinatesNNM:
             small_divisors=tuple((k + 1, n, float(d)) for k, n, d in hierarchy.small_divisors),
             _hierarchy=hierarchy,
         )
+
+
+def release_amplitudes_by_series(system: UnilateralSystem, mode: int, a0: Any, *, dps: int = 30) -> list[tuple[Any, Any]]:
+    """The a_k (k ≠ j) of Corollary 4.2 as Fourier series, summed by mpmath with an error estimate.
+
+    Order one of mode k ≠ j: ``λ_j² v'' + λ_k² v = −Σ_i G_ki (a0 B_ij cos s − b_i)_+`` with the
+    cosine coefficients of the contact functions from the Fourier kernel
+    (``(c cos s − b)_+ = |c| (±1)^l c_l[b/|c|]`` for ±c > 0), so
+
+        a_k = v_k(0) = Σ_l F_{k,l} / (λ_k² − l² λ_j²),   F_{k,l} = −Σ_i G_ki |c_i| (sign c_i)^l c_l[b_i/|c_i|].
+
+    Independent of the branch hierarchy (a cross-check of :func:`nnm`'s closed form).
+
+    Returns
+    -------
+    list of (value, error_estimate)
+        One pair per mode k ≠ j, in increasing mode order.
+    """
+    from ._contact_fourier import contact_ramp_coefficient_mp, series_sum
+
+    modes = system.modes()
+    frequencies, shapes = modes.frequencies, modes.shapes
+    j = mode - 1
+    coupling = float(a0) * (np.asarray(system.A, dtype=float) @ shapes)[:, j]
+    forcing = shapes.T @ np.asarray(system.W, dtype=float)
+    gaps = np.asarray(system.b, dtype=float).reshape(-1)
+    results = []
+    for k in range(system.n_dof):
+        if k == j:
+            continue
+
+        def term(harmonic: Any, k: int = k) -> Any:
+            harmonic = int(harmonic)
+            total = mpmath.mpf(0)
+            for i in range(len(gaps)):
+                if coupling[i] == 0:
+                    continue
+                sign = 1 if coupling[i] > 0 else (-1) ** harmonic
+                ramp = contact_ramp_coefficient_mp(harmonic, gaps[i] / abs(coupling[i]), dps=dps)
+                total += -forcing[k, i] * abs(coupling[i]) * sign * ramp
+            return total / (frequencies[k] ** 2 - harmonic**2 * frequencies[j] ** 2)
+
+        estimate = series_sum(term, start=0, dps=dps)
+        results.append((estimate.value, estimate.error_estimate))
+    return results
 
 
 def nnm(system: UnilateralSystem, mode: int, a0: Any, order: int = 2, *, a1: Any = 0, precision: int = 30) -> NNMExpansion:

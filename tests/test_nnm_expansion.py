@@ -2,7 +2,6 @@
 
 import json
 
-import mpmath
 import numpy as np
 import pytest
 from scipy.optimize import root
@@ -10,7 +9,7 @@ from scipy.optimize import root
 import lindstedt
 from lindstedt import ProblemError, ResonanceError, UnilateralSystem
 from lindstedt._cli import main
-from lindstedt._contact_fourier import contact_ramp_coefficient_mp, series_sum
+from lindstedt._nnm_expansion import release_amplitudes_by_series
 from lindstedt._flow import ExactFlow
 
 EPSILONS = np.geomspace(0.0005, 0.004, 8)  # in units of λ_j² (the small parameter is ε/λ_j²)
@@ -102,24 +101,22 @@ def test_one_dof_limit_reproduces_the_scalar_engine(stiffness, gap, release, ome
         assert float(ours) == pytest.approx(float(theirs), rel=1e-20, abs=1e-25)
 
 
-def test_a_k_matches_the_fourier_series_of_corollary_4_2():
-    # zero gap, one spring: v_k^1 solves λ_j² v'' + λ_k² v = −G_k (a0 B_j cos s)_+; a_k = v_k^1(0) = Σ_l F_l / (λ_k² − l² λ_j²)
-    system = UnilateralSystem.chain(3, unilateral=[(0, 0.0)])
-    frequencies, shapes = system.modes()
-    mode, amplitude = 1, 0.8
-    result = lindstedt.nnm(system, mode=mode + 1, a0=amplitude, order=1)
-    coupling = amplitude * shapes[0, mode]  # a0 B_1j with A = e_1ᵀ
-    for k in (0, 2):
-        force = shapes[0, k]  # G_k1 = Φ_1k (W = Aᵀ)
-        with mpmath.workdps(30):
-            def term(harmonic, k=k, force=force):
-                # (c cos s)_+ = |c| (±cos s)_+ : coefficient of cos(l s) is |c| (±1)^l c_l[0]
-                sign = 1 if coupling > 0 else (-1) ** int(harmonic)
-                coefficient = -force * abs(coupling) * sign * contact_ramp_coefficient_mp(int(harmonic), 0, dps=30)
-                return coefficient / (frequencies[k] ** 2 - harmonic**2 * frequencies[mode] ** 2)
-
-            value, error = series_sum(term, start=0, dps=30)
-        assert float(value) == pytest.approx(float(result.release_modal[k]), rel=1e-12)
+@pytest.mark.parametrize(
+    "springs, mode, amplitude",
+    [
+        ([(0, 0.0)], 2, 0.8),
+        pytest.param([(0, 0.2), (2, -0.1)], 1, 1.0, marks=pytest.mark.slow),
+        pytest.param([(1, 0.05)], 3, -0.7, marks=pytest.mark.slow),
+    ],
+)
+def test_a_k_match_the_fourier_series_of_corollary_4_2(springs, mode, amplitude):
+    # independent route: the Fourier series of the contact functions summed with acceleration
+    system = UnilateralSystem.chain(3, unilateral=springs)
+    result = lindstedt.nnm(system, mode=mode, a0=amplitude, order=1)
+    series = release_amplitudes_by_series(system, mode, amplitude)
+    for (value, error), closed_form in zip(series, result.a_k):
+        assert error < 1e-12
+        assert float(value) == pytest.approx(float(closed_form), rel=1e-11, abs=1e-13)
 
 
 def test_internal_resonance_raises_and_near_resonance_is_reported():
