@@ -139,8 +139,8 @@ class EvaluationPoint:
     --------
     >>> from sympy import QQ
     >>> point = EvaluationPoint(QQ, QQ(0), QQ(1), QQ(0))
-    >>> point.cos_multiple(3), point.sin_multiple(3)
-    (1, 0)
+    >>> print(point.cos_multiple(3), point.sin_multiple(3))
+    1 0
     """
 
     def __init__(self, domain: Any, value: Any, cosine: Any, sine: Any):

@@ -134,7 +134,7 @@ class PiecewiseWaveform:
     >>> v1.breakpoints
     (pi/2,)
     >>> v1.cosine_coefficient(2)
-    -1/(3*pi)
+    2/(9*pi)
     """
 
     order: int
@@ -184,7 +184,7 @@ class Expansion:
     >>> expansion.omega[2]
     -21*a0**4/(256*omega0**3)
     >>> round(expansion.frequency(0.1, values={"a0": 1, "omega0": 1}), 12)
-    1.036679687500
+    1.0366796875
     """
 
     problem: Oscillator

@@ -48,6 +48,7 @@ from sympy import QQ, Rational, RealField
 from ._cosine import CosineSeries, solve_harmonic_oscillator, sum_series
 from ._errors import OrderError, ProblemError, UnsupportedNonlinearityError
 from ._problem import DISPLACEMENT, Oscillator
+from ._series_algebra import extend_square_root
 
 __all__ = ["LindstedtPoincare", "MAX_ORDER", "NormalForm", "SmoothHierarchy", "normal_form"]
 
@@ -251,7 +252,7 @@ class SmoothHierarchy:
     --------
     >>> from lindstedt._problem import Oscillator
     >>> hierarchy = SmoothHierarchy(normal_form(Oscillator("u**3", a0=1, omega0=1)), "initial")
-    >>> hierarchy.squared_frequency(1)
+    >>> print(hierarchy.squared_frequency(1))
     3/4
     """
 
@@ -341,14 +342,7 @@ class SmoothHierarchy:
 
     def frequency(self, order: int) -> Any:
         """``Ω_order``: coefficient of ε̂^order in Ω = sqrt(Σ A_k ε̂^k)."""
-        half = self._domain.convert(Rational(1, 2))
-        while len(self._frequencies) <= order:
-            k = len(self._frequencies)
-            value = self.squared_frequency(k)
-            for i in range(1, k):
-                value = value - self._frequencies[i] * self._frequencies[k - i]
-            self._frequencies.append(value * half)
-        return self._frequencies[order]
+        return extend_square_root(self._frequencies, self.squared_frequency, order, self._domain)
 
     def waveform(self, order: int) -> CosineSeries:
         """``w_order`` (normalised correction of order ``order``)."""

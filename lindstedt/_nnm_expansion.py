@@ -49,6 +49,7 @@ from sympy import RealField
 
 from ._branch import Branch, EvaluationPoint
 from ._errors import ProblemError, ResonanceError
+from ._series_algebra import extend_square_root, shift_powers
 from ._system import UnilateralSystem
 
 __all__ = ["NNMExpansion", "StrainedCoordinatesNNM", "nnm", "release_amplitudes_by_series"]
@@ -265,13 +266,7 @@ class _ModalHierarchy:
         return self._derivatives[key]
 
     def _shift_powers(self, boundary: int, order: int) -> list[list[Any]]:
-        zero = self.domain.zero
-        shifts = [zero] + [self._shifts[i][boundary] for i in range(1, order)] + [zero]
-        powers = [[self.domain.one] + [zero] * order]
-        for _ in range(order):
-            previous = powers[-1]
-            powers.append([sum((previous[j - i] * shifts[i] for i in range(1, j + 1)), zero) for j in range(order + 1)])
-        return powers
+        return shift_powers([terms[boundary] for terms in self._shifts[:order]], order, self.domain)
 
     def _known(self, boundary: int, piece: int, component: int, order: int, derivative: int, powers: list[list[Any]]) -> Any:
         point = self.boundaries[boundary].point
@@ -408,14 +403,7 @@ class _ModalHierarchy:
 
     def frequency(self, order: int) -> Any:
         """Ω_order."""
-        half = self.domain.one / self.domain.convert(2)
-        while len(self._frequency_terms) <= order:
-            k = len(self._frequency_terms)
-            value = self.squared_frequency(k)
-            for i in range(1, k):
-                value = value - self._frequency_terms[i] * self._frequency_terms[k - i]
-            self._frequency_terms.append(value * half)
-        return self._frequency_terms[order]
+        return extend_square_root(self._frequency_terms, self.squared_frequency, order, self.domain)
 
     def release(self, order: int, component: int) -> Any:
         """W_{order, component}(0)."""

@@ -45,6 +45,7 @@ from ._branch import Branch, EvaluationPoint
 from ._errors import ProblemError
 from ._piecewise_linear import LinearInterval, decompose_piecewise_linear
 from ._problem import DISPLACEMENT, Oscillator
+from ._series_algebra import extend_square_root, shift_powers
 
 __all__ = ["ContactBoundary", "PiecewiseNormalForm", "PiecewiseHierarchy", "piecewise_normal_form"]
 
@@ -332,13 +333,7 @@ class PiecewiseHierarchy:
 
     def _shift_powers(self, boundary: int, order: int) -> list[list[Any]]:
         """[δσ^n]_j for n, j <= order, δσ = Σ_{1<=i<order} σ_i ε̂^i (σ_order excluded)."""
-        zero = self._domain.zero
-        shifts = [zero] + [self._boundary_terms[i][boundary] for i in range(1, order)] + [zero]
-        powers = [[self._domain.one] + [zero] * order]
-        for _ in range(order):
-            previous = powers[-1]
-            powers.append([sum((previous[j - i] * shifts[i] for i in range(1, j + 1)), zero) for j in range(order + 1)])
-        return powers
+        return shift_powers([term[boundary] for term in self._boundary_terms[:order]], order, self._domain)
 
     def _known_at_boundary(self, boundary: int, piece: int, order: int, derivative: int, powers: list[list[Any]]) -> Any:
         """ε̂^order coefficient of ∂^derivative W^piece at s*(ε̂), without W_order and σ_order."""
@@ -480,14 +475,7 @@ class PiecewiseHierarchy:
 
     def frequency(self, order: int) -> Any:
         """Ω_order: coefficient of ε̂^order in Ω."""
-        half = self._domain.convert(QQ(1, 2))
-        while len(self._frequencies) <= order:
-            k = len(self._frequencies)
-            value = self.squared_frequency(k)
-            for i in range(1, k):
-                value = value - self._frequencies[i] * self._frequencies[k - i]
-            self._frequencies.append(value * half)
-        return self._frequencies[order]
+        return extend_square_root(self._frequencies, self.squared_frequency, order, self._domain)
 
     def branches(self, order: int) -> list[Branch]:
         """W_order on each piece (analytic branches)."""

@@ -1,0 +1,51 @@
+"""Truncated power series in ε shared by the hierarchies (coefficients in a sympy domain).
+
+* ``Ω = sqrt(Σ A_k ε^k)`` with ``A_0 = Ω_0 = 1``:  ``Ω_k = (A_k − Σ_{i=1}^{k−1} Ω_i Ω_{k−i}) / 2``;
+* powers of a boundary shift ``δσ(ε) = Σ_{i≥1} σ_i ε^i`` (Taylor expansions about a contact angle).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+from sympy import Rational
+
+__all__ = ["extend_square_root", "shift_powers"]
+
+
+def extend_square_root(roots: list[Any], squared: Callable[[int], Any], order: int, domain: Any) -> Any:
+    """Extend ``roots`` (Ω_0 = 1, Ω_1, …) in place up to ``order`` from ``squared(k) = A_k``; return Ω_order.
+
+    Examples
+    --------
+    >>> from sympy import QQ
+    >>> roots = [QQ(1)]
+    >>> print(extend_square_root(roots, lambda k: [QQ(1), QQ(1, 2), QQ(-3, 16)][k], 2, QQ))   # Ω² = 1 + ε/2 − 3ε²/16
+    -1/8
+    """
+    half = domain.convert(Rational(1, 2))
+    while len(roots) <= order:
+        k = len(roots)
+        value = squared(k)
+        for i in range(1, k):
+            value = value - roots[i] * roots[k - i]
+        roots.append(value * half)
+    return roots[order]
+
+
+def shift_powers(shifts: list[Any], order: int, domain: Any) -> list[list[Any]]:
+    """``[δσ^n]_j`` for n, j ≤ order, where ``shifts[i] = σ_i`` (``shifts[0]`` ignored, missing ones zero).
+
+    Examples
+    --------
+    >>> from sympy import QQ
+    >>> [str(c) for c in shift_powers([QQ(0), QQ(2)], 2, QQ)[2]]     # (2ε)² = 4ε²
+    ['0', '0', '4']
+    """
+    zero = domain.zero
+    padded = [zero] + [shifts[i] if i < len(shifts) else zero for i in range(1, order + 1)]
+    powers = [[domain.one] + [zero] * order]
+    for _ in range(order):
+        previous = powers[-1]
+        powers.append([sum((previous[j - i] * padded[i] for i in range(1, j + 1)), zero) for j in range(order + 1)])
+    return powers
