@@ -4,7 +4,7 @@ Usage::
 
     python benchmarks/run.py            # full run (the README's numbers)
     python benchmarks/run.py --quick    # smoke run: fewer orders, fewer repeats
-    python benchmarks/run.py --only duffing-orders [--output some.md]
+    python benchmarks/run.py --only duffing-orders [--output some.md]   # re-runs that section, keeps the others
 
 Adding a benchmark: write ``benchmarks/bench_<name>.py`` with a function
 ``run(quick: bool = False) -> str`` that returns one markdown section (starting with a ``## `` heading),
@@ -32,12 +32,27 @@ from _common import REPO_DIR, machine_facts  # noqa: E402
 #: name -> (module in benchmarks/, function name). The function takes ``quick`` and returns a markdown section.
 REGISTRY: dict[str, tuple[str, str]] = {
     "duffing-orders": ("bench_duffing_orders", "run"),
+    "unilateral": ("bench_unilateral", "run"),
 }
 
 
 def _resolve(name: str) -> Callable[..., str]:
     module_name, function_name = REGISTRY[name]
     return getattr(importlib.import_module(module_name), function_name)
+
+
+def _split_sections(markdown: str) -> list[str]:
+    """The ``## `` sections of a generated README (the head before the first one is dropped)."""
+    parts = ("\n" + markdown).split("\n## ")[1:]
+    return ["## " + part.rstrip() + "\n" for part in parts]
+
+
+def _merge_sections(old_markdown: str, new_sections: list[str]) -> tuple[list[str], int]:
+    """Keep the existing README's sections, replacing those re-run now (same heading line); append the others."""
+    new_by_heading = {section.splitlines()[0]: section for section in new_sections}
+    merged = [new_by_heading.pop(old.splitlines()[0], old) for old in _split_sections(old_markdown)]
+    kept = len(merged) - (len(new_sections) - len(new_by_heading))
+    return merged + list(new_by_heading.values()), kept
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -63,6 +78,9 @@ def main(argv: list[str] | None = None) -> int:
             sections.append(f"## {name}\n\n**FAILED**:\n\n```\n{traceback.format_exc()}```\n")
         print(f"[run] {name} done in {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
     total = time.perf_counter() - started
+    kept = 0
+    if args.only and args.output.exists():  # --only: re-run these sections, keep the others of the existing file
+        sections, kept = _merge_sections(args.output.read_text(), sections)
 
     head = [
         "# lindstedt benchmarks",
@@ -79,7 +97,9 @@ def main(argv: list[str] | None = None) -> int:
         *[f"| {key} | {value} |" for key, value in facts.items()],
         "",
         "Benchmarks: " + ", ".join(f"`{n}`" for n in names) + ". Each one times every tool in fresh subprocesses; "
-        "peers are installed only into gitignored, cached venvs under `benchmarks/` (never project dependencies).",
+        "peers are installed only into gitignored, cached venvs under `benchmarks/` (never project dependencies)."
+        + (f" {kept} other section(s) below were kept from the previous run of this file (machine facts above "
+           "describe this run only; each section states its own load and timing)." if kept else ""),
         "",
     ]
     args.output.write_text("\n".join(head) + "\n" + "\n".join(sections))

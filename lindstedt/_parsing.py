@@ -3,8 +3,8 @@
 Strings are tokenised first and every name is checked against a whitelist of
 mathematical functions, the variable ``u`` and the declared parameters, so no
 attribute access, dunder name or builtin can reach sympy's evaluator.  ``^`` is
-read as a power.  Decimal strings such as ``"0.1"`` are read *exactly* (as
-``1/10``).
+read as a power.  Decimals — a value ``"0.1"`` or a literal inside an
+expression, ``"Max(0, u - 0.3)"`` — are read *exactly* (as ``1/10``, ``3/10``).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import tokenize
 from typing import Any, Iterable, Mapping
 
 import sympy
-from sympy.parsing.sympy_parser import convert_xor, parse_expr, standard_transformations
+from sympy.parsing.sympy_parser import convert_xor, parse_expr, rationalize, standard_transformations
 
 from ._errors import ParameterError, ProblemError
 
@@ -136,7 +136,7 @@ def parse_expression(
             text,
             local_dict=local_names,
             global_dict=dict(_PARSER_GLOBALS),
-            transformations=standard_transformations + (convert_xor,),
+            transformations=standard_transformations + (convert_xor, rationalize),
             evaluate=True,
         )
     except (SyntaxError, TypeError, ValueError, AttributeError, ZeroDivisionError, tokenize.TokenError) as error:

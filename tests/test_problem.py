@@ -76,3 +76,8 @@ def test_non_smooth_and_non_analytic_f_are_refused_with_guidance():
         lindstedt.expand("1/u", order=2, a0=1, omega0=1)
     with pytest.raises(UnsupportedNonlinearityError, match="analytic"):
         lindstedt.expand("sqrt(u + 1/2)", order=2, a0=1, omega0=1)
+
+
+def test_decimal_literals_inside_f_are_exact():
+    problem = Oscillator("Max(0, u - 0.3) + 2.5*u**3", a0=1, omega0=1)
+    assert problem.f == sympy.Max(0, problem.variable - sympy.Rational(3, 10)) + sympy.Rational(5, 2) * problem.variable**3
