@@ -27,7 +27,15 @@ from ._flow import ExactFlow
 from ._hierarchy import LindstedtPoincare
 from ._nnm_expansion import NNMExpansion, StrainedCoordinatesNNM, nnm
 from ._problem import Oscillator
+from ._spectrum import Spectrum, exact_spectrum, expansion_spectrum, spectrum
 from ._system import Modes, UnilateralSystem
+from ._validation import (
+    contact_measure,
+    expansion_error,
+    fitted_convergence_order,
+    fitted_validity_exponent,
+    reference_solution,
+)
 
 __version__ = "0.1.0"
 
@@ -42,6 +50,15 @@ __all__ = [
     "StrainedCoordinatesNNM",
     "NNMExpansion",
     "ExactFlow",
+    "reference_solution",
+    "expansion_error",
+    "fitted_convergence_order",
+    "fitted_validity_exponent",
+    "contact_measure",
+    "spectrum",
+    "Spectrum",
+    "expansion_spectrum",
+    "exact_spectrum",
     "LindstedtPoincare",
     "Expansion",
     "Waveform",
