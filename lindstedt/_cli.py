@@ -71,6 +71,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     demo = commands.add_parser("demo", help="the tour: Duffing and u_+ expansions checked against exact references")
     demo.add_argument("--order", type=int, default=8, help="Duffing order to derive (default 8)")
+    demo.add_argument("--figure", default="lindstedt-demo.svg", help="where to write the SVG figure (default lindstedt-demo.svg; '' for none)")
     return parser
 
 
@@ -139,7 +140,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         elif arguments.command == "demo":
             from ._demo import run_demo
 
-            output = run_demo(order=arguments.order)
+            output = run_demo(order=arguments.order, figure_path=arguments.figure or None)
         else:  # pragma: no cover - argparse enforces the choices
             parser.error(f"unknown command {arguments.command}")
             return 2
