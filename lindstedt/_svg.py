@@ -69,6 +69,7 @@ def line_plot_svg(
         points = " ".join(f"{a:.2f},{b:.2f}" for a, b in zip(px, py))
         colour = _COLOURS[index % len(_COLOURS)]
         parts.append(f'<polyline fill="none" stroke="{colour}" stroke-width="1.5" points="{points}"/>')
-        parts.append(f'<text x="{width - margin_right - 10}" y="{margin_top + 16 * (index + 1)}" text-anchor="end" fill="{colour}">{label}</text>')
+        legend_y = height - margin_bottom - 10 - 16 * (len(curves) - 1 - index)
+        parts.append(f'<text x="{width - margin_right - 10}" y="{legend_y}" text-anchor="end" fill="{colour}">{label}</text>')
     parts.append("</svg>")
     return "\n".join(parts) + "\n"
