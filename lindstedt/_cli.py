@@ -7,6 +7,8 @@ Sub-commands
     Lindstedt–Poincaré expansion of the oscillator with nonlinearity F.
 ``lindstedt nnm SYSTEM.json --mode J --a0 A [--order 2] [--format text|latex|json]``
     Nonlinear normal mode of M X'' + K X + ε W (A X − b)_+ = 0 grown from mode J.
+``lindstedt derive NAME [--order N] [--format text|latex|json] [--output DIR]`` / ``lindstedt derive --list``
+    Named derivations (Duffing, u_+, gaps, grazing, NNMs, all modes).
 ``lindstedt demo``
     The tour: derives the Duffing and unilateral-spring expansions, prints them
     and their agreement with the exact references.
@@ -69,6 +71,13 @@ def build_parser() -> argparse.ArgumentParser:
     nnm.add_argument("--precision", type=int, default=30, help="decimal digits of the arithmetic (default 30)")
     nnm.add_argument("--format", choices=("text", "latex", "json"), default="text")
 
+    derive = commands.add_parser("derive", help="run a named derivation (LaTeX fragment + JSON coefficients)")
+    derive.add_argument("name", nargs="?", help="derivation name (see --list)")
+    derive.add_argument("--list", action="store_true", help="list the named derivations")
+    derive.add_argument("--order", type=int, default=None, help="expansion order (default: the derivation's own)")
+    derive.add_argument("--format", choices=("text", "latex", "json"), default="text")
+    derive.add_argument("--output", default=None, help="directory to write NAME.tex and NAME.json into")
+
     demo = commands.add_parser("demo", help="the tour: Duffing and u_+ expansions checked against exact references")
     demo.add_argument("--order", type=int, default=8, help="Duffing order to derive (default 8)")
     demo.add_argument("--figure", default="lindstedt-demo.svg", help="where to write the SVG figure (default lindstedt-demo.svg; '' for none)")
@@ -119,6 +128,18 @@ def _command_nnm(arguments: argparse.Namespace) -> str:
     return result.summary()
 
 
+def _command_derive(arguments: argparse.Namespace) -> str:
+    from ._derive import derive, format_derivation, list_derivations
+    from ._errors import ProblemError
+
+    if arguments.list:
+        return "\n".join(f"{name:18s} {description}" for name, description in list_derivations())
+    if not arguments.name:
+        raise ProblemError("name a derivation (lindstedt derive --list shows them)")
+    result = derive(arguments.name, order=arguments.order, output_directory=arguments.output)
+    return format_derivation(result, arguments.format)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status.
 
@@ -137,6 +158,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             output = _command_expand(arguments)
         elif arguments.command == "nnm":
             output = _command_nnm(arguments)
+        elif arguments.command == "derive":
+            output = _command_derive(arguments)
         elif arguments.command == "demo":
             from ._demo import run_demo
 

@@ -23,7 +23,9 @@ JSON schema ``lindstedt.expansion/1`` (:meth:`Expansion.to_dict`)::
       "omega_float": [float | null],  # null where symbolic
       "alpha": [str, ...], "alpha_float": [float | null],
       "omega_next": str,              # ω_{N+1}, used by the displacement evaluator
-      "waveforms": [{"order": k, "cosine_coefficients": {"n": str}}]   # optional
+      "waveforms": [{"order": k, "cosine_coefficients": {"n": str}}]   # optional; piecewise f:
+                   [{"order": k, "breakpoints": [str], "pieces": [str], "interval": str}]
+      "regime", "validity_exponent", "contact_angles"                   # piecewise f only
     }
 """
 
@@ -168,6 +170,19 @@ class PiecewiseWaveform:
     def value_at_zero(self) -> sympy.Expr:
         """v_k(0) exactly."""
         return sympy.simplify(self.branches[0].subs(STRAINED_TIME, 0))
+
+    def to_latex(self) -> str:
+        """LaTeX (``cases`` on [0, π]) through sympy's printer."""
+        return _latex(self.to_expr())
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: breakpoints (contact angles) and one sympy-parsable branch per piece."""
+        return {
+            "order": self.order,
+            "interval": "[0, pi], extended evenly and 2*pi-periodically",
+            "breakpoints": [sympy.sstr(value) for value in self.breakpoints],
+            "pieces": [sympy.sstr(branch) for branch in self.branches],
+        }
 
 
 @dataclass(frozen=True)
@@ -503,9 +518,15 @@ class Expansion:
         }
         if waveforms:
             data["waveforms"] = [
-                {"order": w.order, "cosine_coefficients": {str(n): sympy.sstr(c) for n, c in w.coefficients}}
+                w.to_dict()
+                if isinstance(w, PiecewiseWaveform)
+                else {"order": w.order, "cosine_coefficients": {str(n): sympy.sstr(c) for n, c in w.coefficients}}
                 for w in self.waveforms
             ]
+        if self.is_piecewise:
+            data["regime"] = self.regime
+            data["validity_exponent"] = str(self.validity_exponent)
+            data["contact_angles"] = [sympy.sstr(value) for value in self.contact_angles]
         return data
 
     def to_json(self, *, waveforms: bool = True, indent: int | None = 2) -> str:

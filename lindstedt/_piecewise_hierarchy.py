@@ -155,6 +155,13 @@ def _compare(value: sympy.Expr, bound: int) -> int | None:
     return None
 
 
+def _contact_sine(kappa: sympy.Expr) -> sympy.Expr:
+    """sin β = sqrt(1 − κ²), without sympy's perfect-power search for rationals with huge denominators."""
+    if kappa.is_Rational and kappa.q > 10**12:
+        return sympy.Pow(1 - kappa**2, sympy.Rational(1, 2), evaluate=False)
+    return sympy.sqrt(1 - kappa**2)
+
+
 def _guard_digits(kappas: list[sympy.Expr], order: int) -> int:
     """Extra working digits for a float hierarchy near grazing.
 
@@ -231,7 +238,7 @@ def piecewise_normal_form(problem: Oscillator, digits: int | None = None, order_
         _, _, slope, intercept = w_intervals[interval_index]
         values += [slope, intercept]
     for kappa in crossing_kappas:
-        values += [kappa, sympy.acos(kappa), sympy.sqrt(1 - kappa**2)]
+        values += [kappa, sympy.acos(kappa), _contact_sine(kappa)]
     numeric = digits is not None or any(value.has(sympy.Float) for value in values)
     if numeric:
         digits = (digits or 30) + _guard_digits(crossing_kappas, order_hint)
@@ -245,7 +252,7 @@ def piecewise_normal_form(problem: Oscillator, digits: int | None = None, order_
     for kappa in sorted(crossing_kappas, key=lambda k: -k if k.is_number else 0):
         angle = sympy.acos(kappa)
         kappa_element = field.convert(kappa)
-        sine_element = field.convert(sympy.sqrt(1 - kappa**2))
+        sine_element = field.convert(_contact_sine(kappa))
         point = EvaluationPoint(domain, field.convert(angle), kappa_element, sine_element)
         boundaries.append(ContactBoundary(kappa, angle, point, kappa_element, sine_element))
     zero = EvaluationPoint(domain, domain.zero, domain.one, domain.zero)

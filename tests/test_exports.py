@@ -92,3 +92,18 @@ def test_cli_latex_and_text(capsys):
 def test_cli_errors_are_clear_and_exit_2(capsys, arguments, fragment):
     assert main(arguments) == 2
     assert fragment in capsys.readouterr().err
+
+
+def test_piecewise_exports_latex_and_json():
+    expansion = lindstedt.expand("Max(0, u - 1/3)", order=2, a0=1, omega0=1)
+    latex = expansion.to_latex(waveforms=True)
+    assert r"\begin{cases}" in latex and "v_{2}(s)" in latex
+    data = json.loads(expansion.to_json())
+    assert data["regime"] == "contact" and data["validity_exponent"] == "-1"
+    assert data["contact_angles"] == ["acos(1/3)"]
+    first = data["waveforms"][1]
+    assert first["breakpoints"] == ["acos(1/3)"] and len(first["pieces"]) == 2
+    s = sympy.Symbol("s")
+    piece = sympy.sympify(first["pieces"][0], locals={"s": s})
+    reference = expansion.waveforms[1].branches[0].subs(sympy.Symbol("s", real=True), s)
+    assert sympy.simplify(piece - reference) == 0

@@ -1,0 +1,305 @@
+"""The named derivations (``lindstedt._derive`` and ``derivations/*.py``).
+
+Every registered case runs at a small order, writes LaTeX with balanced
+environments and braces and parsable JSON with ``"omega"``, and its numbers —
+read back from the JSON text — agree with an independent reference: the exact
+Duffing series (elliptic K), the exact u_+ period series, the Cauchy-integral
+Taylor coefficients of the exact piecewise-linear period (1e-20), analytic
+chain frequencies and the zero-gap closed form of Theorem 4.3.  Every script
+also runs as a subprocess.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import mpmath
+import pytest
+import sympy
+
+from lindstedt import OrderError, ProblemError
+from lindstedt._derive import DERIVATIONS, DerivationResult, derive, format_derivation, list_derivations
+from lindstedt._reference_duffing import duffing_frequency_taylor
+from lindstedt._reference_piecewise import piecewise_linear_frequency_taylor, piecewise_linear_frequency_taylor_symbolic
+
+REPOSITORY = Path(__file__).resolve().parent.parent
+SCRIPTS = REPOSITORY / "derivations"
+NAMES = ["duffing", "u_plus", "gap", "prestress", "negative_release", "grazing", "nnm_2dof", "nnm_5dof", "all_modes"]
+#: Small orders keep the suite fast; each still exercises the order-2 machinery where there is one.
+SMALL_ORDER = {
+    "duffing": 4, "u_plus": 3, "gap": 2, "prestress": 2, "negative_release": 2,
+    "grazing": 2, "nnm_2dof": 2, "nnm_5dof": 1, "all_modes": 1,
+}
+PIECEWISE_TOLERANCE = 1e-20  # absolute, ω_k against the 40-digit Cauchy-integral reference
+NNM_TOLERANCE = 1e-25  # absolute, 30-digit N-dof arithmetic against closed forms
+FLOAT_TOLERANCE = 1e-13  # relative, float closed forms (Theorem 4.3)
+
+A0 = sympy.Symbol("a0", positive=True)
+OMEGA0 = sympy.Symbol("omega0", positive=True)
+EPSILON = sympy.Symbol("epsilon")
+A = sympy.Symbol("a", real=True)
+KAPPA, BETA, SIGMA = sympy.Symbol("kappa", real=True), sympy.Symbol("beta", positive=True), sympy.Symbol("sigma", positive=True)
+LOCALS = {"a0": A0, "omega0": OMEGA0, "a": A, "kappa": KAPPA, "beta": BETA, "sigma": SIGMA}
+
+
+def parse(text: str) -> sympy.Expr:
+    return sympy.sympify(text, locals=LOCALS)
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory) -> dict[str, DerivationResult]:
+    """Each derivation at its small order, written into one temporary directory (computed once)."""
+    directory = tmp_path_factory.mktemp("derivations")
+    return {name: derive(name, order=SMALL_ORDER[name], output_directory=directory) for name in NAMES}
+
+
+# --------------------------------------------------------------------------- #
+# registry and API
+# --------------------------------------------------------------------------- #
+def test_registry_lists_the_named_cases_in_order_with_one_line_descriptions():
+    assert [name for name, _ in list_derivations()] == NAMES
+    for name, description in list_derivations():
+        assert description and "\n" not in description
+        spec = DERIVATIONS[name]
+        assert spec.name == name and spec.description == description
+        assert 1 <= spec.default_order <= spec.max_order
+    with pytest.raises(TypeError):
+        DERIVATIONS["new"] = DERIVATIONS["gap"]  # read-only mapping
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        DERIVATIONS["gap"].default_order = 7
+
+
+def test_bad_requests_raise_typed_errors_naming_the_fix():
+    with pytest.raises(ProblemError, match="duffing"):
+        derive("no_such_case")
+    for order in (0, 13, True, 1.5):
+        with pytest.raises(OrderError):
+            derive("nnm_2dof", order=order)
+    with pytest.raises(OrderError, match="only order 1"):
+        derive("all_modes", order=2)
+    with pytest.raises(ProblemError, match="format"):
+        derive("grazing", order=1, formats=("pdf",))
+
+
+def test_without_output_directory_nothing_is_written_and_formats_select_files(tmp_path):
+    quiet = derive("grazing", order=1)
+    assert quiet.paths == () and quiet.order == 1 and quiet.name == "grazing"
+    only_json = derive("grazing", order=1, output_directory=tmp_path / "new" / "dir", formats=("json",))
+    assert only_json.paths == (tmp_path / "new" / "dir" / "grazing.json",)
+    assert [path.name for path in (tmp_path / "new" / "dir").iterdir()] == ["grazing.json"]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        quiet.order = 2
+
+
+def test_default_order_comes_from_the_spec():
+    assert derive("all_modes").order == DERIVATIONS["all_modes"].default_order == 1
+
+
+def test_format_derivation(results):
+    result = results["gap"]
+    assert format_derivation(result, "latex") == result.latex.rstrip("\n")
+    assert json.loads(format_derivation(result, "json")) == result.json
+    text = format_derivation(result, "text")
+    assert text.startswith("gap (order 2)")
+    assert all(str(path) in text for path in result.paths)
+    with pytest.raises(ProblemError):
+        format_derivation(result, "pdf")
+
+
+# --------------------------------------------------------------------------- #
+# every derivation: files, LaTeX, JSON
+# --------------------------------------------------------------------------- #
+def assert_valid_latex(text: str) -> None:
+    assert text.isascii(), "the fragment must be pure ASCII (pdflatex)"
+    stack: list[str] = []
+    for kind, environment in re.findall(r"\\(begin|end)\{([^}]*)\}", text):
+        if kind == "begin":
+            stack.append(environment)
+        else:
+            assert stack and stack.pop() == environment, f"unbalanced \\end{{{environment}}}"
+    assert not stack, f"unclosed environments {stack}"
+    body = "\n".join(line for line in text.splitlines() if not line.lstrip().startswith("%"))
+    body = body.replace(r"\{", "").replace(r"\}", "")
+    depth = 0
+    for character in body:
+        depth += {"{": 1, "}": -1}.get(character, 0)
+        assert depth >= 0, "a closing brace without its opening brace"
+    assert depth == 0, "unbalanced braces"
+    assert body.count("$") % 2 == 0, "unbalanced inline math"
+    assert re.search(r"\\begin\{align\*\}", text) and "\\subsection*" in text
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_derivation_writes_valid_latex_and_json(results, name):
+    result = results[name]
+    assert [path.name for path in result.paths] == [f"{name}.tex", f"{name}.json"]
+    tex, data_file = result.paths
+    assert tex.read_text(encoding="utf-8") == result.latex
+    assert_valid_latex(result.latex)
+    assert "varepsilon^{-1" in result.latex  # the validity time scale is stated
+    data = json.loads(data_file.read_text(encoding="utf-8"))
+    assert data == json.loads(json.dumps(result.json))
+    assert data["schema"] == "lindstedt.derivation/1" and data["name"] == name and data["order"] == result.order
+    assert data["omega"] and data["omega"].keys() == data["omega_float"].keys()
+    expected_length = 2 if name == "all_modes" else result.order + 1
+    for values in data["omega"].values():
+        assert len(values) == expected_length and all(isinstance(value, str) for value in values)
+    assert all(check["agrees"] for check in data["checks"]), data["checks"]
+
+
+# --------------------------------------------------------------------------- #
+# numbers against independent references (read back from the JSON)
+# --------------------------------------------------------------------------- #
+@pytest.mark.parametrize("normalization", ["initial", "harmonic"])
+def test_duffing_equals_the_exact_elliptic_series(results, normalization):
+    data = json.loads(results["duffing"].paths[1].read_text(encoding="utf-8"))
+    order = SMALL_ORDER["duffing"]
+    reference = duffing_frequency_taylor(order, normalization=normalization)
+    for k, text in enumerate(data["omega"][normalization]):
+        assert sympy.simplify(parse(text) - OMEGA0 * reference[k] * (A0**2 / OMEGA0**2) ** k) == 0
+
+
+def test_u_plus_equals_the_exact_period_series(results):
+    data = results["u_plus"].json
+    series = piecewise_linear_frequency_taylor_symbolic(SMALL_ORDER["u_plus"], epsilon=EPSILON, a=A, omega0=OMEGA0)
+    for k, text in enumerate(data["omega"]["a u_+"]):
+        assert sympy.simplify(parse(text) - series.coeff(EPSILON, k)) == 0
+    assert data["variants"][0]["contact_angles"] == ["pi/2"]
+
+
+@pytest.mark.parametrize(
+    ("name", "label", "b", "a0"),
+    [("gap", "kappa = 1/3", "1/3", 1), ("prestress", "kappa = -1/2", "-1/2", 1), ("negative_release", "a0 = -1", "1/3", -1)],
+)
+def test_piecewise_cases_equal_the_exact_period_taylor_coefficients(results, name, label, b, a0):
+    data = results[name].json
+    order = SMALL_ORDER[name]
+    with mpmath.workdps(40):
+        reference = piecewise_linear_frequency_taylor(order, a=1, b=mpmath.mpf(sympy.Rational(b).p) / sympy.Rational(b).q, a0=a0, dps=40)
+        for k, text in enumerate(data["omega"][label]):
+            value = mpmath.mpf(str(sympy.N(parse(text), 40)))
+            assert abs(value - reference[k][0]) <= PIECEWISE_TOLERANCE, (name, k)
+    variant = data["variants"][0]
+    assert variant["regime"] == "contact" and variant["validity"]["exponent"] == "-1"
+
+
+def test_gap_closed_forms_in_kappa_against_independent_references(results):
+    forms = results["gap"].json["closed_forms"]["omega"]
+    omega1, omega2 = parse(forms["omega_1"]), parse(forms["omega_2"])
+
+    def at(expression, kappa):
+        return expression.subs({KAPPA: kappa, BETA: sympy.acos(kappa), SIGMA: sympy.sqrt(1 - kappa**2)})
+
+    # κ = 0 is the spring without gap: ω1 = 1/(4ω0), ω2 = -1/(8ω0³) exactly
+    series = piecewise_linear_frequency_taylor_symbolic(2, epsilon=EPSILON, a=1, omega0=OMEGA0)
+    assert sympy.simplify(at(omega1, 0) - series.coeff(EPSILON, 1)) == 0
+    assert sympy.simplify(at(omega2, 0) - series.coeff(EPSILON, 2)) == 0
+    # any |κ| < 1, both signs: the exact period (ω0 = 1)
+    for kappa in (sympy.Rational(1, 3), sympy.Rational(-1, 2), sympy.Rational(7, 10)):
+        with mpmath.workdps(40):
+            reference = piecewise_linear_frequency_taylor(2, a=1, b=mpmath.mpf(kappa.p) / kappa.q, a0=1, dps=40)
+            for k, form in ((1, omega1), (2, omega2)):
+                value = mpmath.mpf(str(sympy.N(at(form, kappa).subs(OMEGA0, 1), 40)))
+                assert abs(value - reference[k][0]) <= PIECEWISE_TOLERANCE, (kappa, k)
+    assert r"\omega_{1} &= \frac{\beta - \kappa \sigma}{2 \pi \omega_{0}}" in results["gap"].latex
+
+
+def test_negative_release_shares_omega_1_with_the_positive_release_only(results):
+    differences = [float(value) for value in results["negative_release"].json["comparison_with_positive_release"]["omega_difference"]]
+    assert differences[0] == 0 and abs(differences[1]) < 1e-25 and abs(differences[2]) > 1e-3
+
+
+def test_grazing_flags_the_regime_and_reduces_to_the_linear_approximation(results):
+    data = results["grazing"].json
+    for variant in data["variants"]:
+        assert variant["regime"] == "grazing"
+        assert variant["validity"]["exponent"] == "-1/2"
+        assert variant["contact_angles"] == []
+    assert data["omega"]["b = a0"] == ["omega0", "0", "0"]
+    linear = sympy.series(sympy.sqrt(OMEGA0**2 + EPSILON), EPSILON, 0, 3).removeO()
+    for k, text in enumerate(data["omega"]["b = -a0"]):
+        assert sympy.simplify(parse(text) - linear.coeff(EPSILON, k)) == 0
+    assert {row["difference"] for row in data["exact_comparison"]["rows"]["b = a0"]} == {"0.0"}
+    assert r"\varepsilon^{-1/2}" in results["grazing"].latex
+
+
+def test_nnm_2dof_every_mode_against_closed_forms(results):
+    data = results["nnm_2dof"].json
+    assert list(data["omega"]) == ["mode 1", "mode 2"]
+    # chain of 2: λ = 1, √3; zero-gap spring on mass 1: ω1 = φ_1j² / (4 λ_j) with φ_1j = 1/√2
+    with mpmath.workdps(40):
+        for j, lam in enumerate([mpmath.mpf(1), mpmath.sqrt(3)]):
+            omegas = [mpmath.mpf(text) for text in data["omega"][f"mode {j + 1}"]]
+            assert abs(omegas[0] - lam) <= NNM_TOLERANCE
+            assert abs(omegas[1] - 1 / (8 * lam)) <= NNM_TOLERANCE
+    for variant in data["variants"]:
+        assert len(variant["nnm"]["a_k"]) == 1 and variant["validity"]["exponent"] == "-1"
+
+
+def test_nnm_5dof_uses_the_documented_springs_and_every_mode(results):
+    data = results["nnm_5dof"].json
+    assert [spring["gap"] for spring in data["system"]["springs"]] == ["0", "-1/5"]
+    assert data["system"]["definition"]["b"] == ["0", "-1/5"]
+    with mpmath.workdps(40):
+        for j in range(1, 6):
+            omegas = data["omega"][f"mode {j}"]
+            assert abs(mpmath.mpf(omegas[0]) - 2 * mpmath.sin(j * mpmath.pi / 12)) <= NNM_TOLERANCE
+    assert len(data["checks"]) == 5
+    assert "preloaded" in results["nnm_5dof"].latex
+
+
+def test_all_modes_zero_gap_corrections_equal_the_closed_form(results):
+    data = results["all_modes"].json
+    for k in range(1, 4):
+        lam, correction = (float(text) for text in data["omega"][f"zero gaps, mode {k}"])
+        shape = mpmath.sqrt(mpmath.mpf(1) / 2) * mpmath.sin(k * mpmath.pi / 4)  # φ_1k of the 3-mass chain
+        assert lam == pytest.approx(float(2 * mpmath.sin(k * mpmath.pi / 8)), rel=FLOAT_TOLERANCE)
+        assert correction == pytest.approx(float(shape**2 / (4 * lam)), rel=FLOAT_TOLERANCE)
+    gapped = next(variant for variant in data["variants"] if variant["label"] == "with a gap")
+    assert {entry["method"] for entry in gapped["corrections"]} == {"almost-periodic average"}
+
+
+# --------------------------------------------------------------------------- #
+# the scripts
+# --------------------------------------------------------------------------- #
+def test_every_script_runs_and_prints_where_it_wrote(tmp_path):
+    processes = {}
+    for name in NAMES:
+        command = [sys.executable, str(SCRIPTS / f"{name}.py"), "--order", str(min(SMALL_ORDER[name], 2)), "--output", str(tmp_path / name)]
+        processes[name] = subprocess.Popen(command, cwd=REPOSITORY, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    failing = subprocess.Popen(
+        [sys.executable, str(SCRIPTS / "grazing.py"), "--order", "0", "--output", str(tmp_path / "bad")],
+        cwd=REPOSITORY, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )
+    for name, process in processes.items():
+        stdout, stderr = process.communicate(timeout=120)
+        assert process.returncode == 0, (name, stderr)
+        expected = [tmp_path / name / f"{name}.tex", tmp_path / name / f"{name}.json"]
+        assert [Path(line) for line in stdout.split()] == expected
+        assert "omega" in json.loads(expected[1].read_text(encoding="utf-8"))
+        assert_valid_latex(expected[0].read_text(encoding="utf-8"))
+    _, stderr = failing.communicate(timeout=120)
+    assert failing.returncode == 2 and stderr.startswith("error:") and not (tmp_path / "bad").exists()
+
+
+def test_every_registered_name_has_a_script_and_no_script_is_unregistered():
+    scripts = {path.stem for path in SCRIPTS.glob("*.py")}
+    assert scripts == set(NAMES)
+    assert "output/" in (SCRIPTS / ".gitignore").read_text(encoding="utf-8").split()
+
+
+def test_cli_derive_list_and_run(tmp_path, capsys):
+    from lindstedt._cli import main
+
+    assert main(["derive", "--list"]) == 0
+    assert "duffing" in capsys.readouterr().out
+    assert main(["derive", "u_plus", "--order", "2", "--format", "json", "--output", str(tmp_path)]) == 0
+    assert '"omega"' in capsys.readouterr().out
+    assert (tmp_path / "u_plus.tex").exists() and (tmp_path / "u_plus.json").exists()
+    assert main(["derive", "no_such_case"]) == 2
+    assert "unknown derivation" in capsys.readouterr().err
