@@ -33,6 +33,7 @@ from _common import REPO_DIR, machine_facts  # noqa: E402
 REGISTRY: dict[str, tuple[str, str]] = {
     "duffing-orders": ("bench_duffing_orders", "run"),
     "unilateral": ("bench_unilateral", "run"),
+    "nnm-branch": ("bench_nnm_branch", "run"),
 }
 
 

@@ -26,6 +26,7 @@ from ._expansion import Expansion, PiecewiseWaveform, Waveform
 from ._flow import ExactFlow
 from ._hierarchy import LindstedtPoincare
 from ._nnm_expansion import NNMExpansion, StrainedCoordinatesNNM, nnm
+from ._nnm_numeric import NNMBranch, NNMResult, continue_nnm, nnm_point, nnm_sweep, seed_example_system
 from ._problem import Oscillator
 from ._spectrum import Spectrum, exact_spectrum, expansion_spectrum, spectrum
 from ._system import Modes, UnilateralSystem
@@ -50,6 +51,12 @@ __all__ = [
     "StrainedCoordinatesNNM",
     "NNMExpansion",
     "ExactFlow",
+    "nnm_point",
+    "continue_nnm",
+    "nnm_sweep",
+    "NNMResult",
+    "NNMBranch",
+    "seed_example_system",
     "reference_solution",
     "expansion_error",
     "fitted_convergence_order",

@@ -7,6 +7,8 @@ Sub-commands
     Lindstedt–Poincaré expansion of the oscillator with nonlinearity F.
 ``lindstedt nnm SYSTEM.json --mode J --a0 A [--order 2] [--format text|latex|json]``
     Nonlinear normal mode of M X'' + K X + ε W (A X − b)_+ = 0 grown from mode J.
+``lindstedt nnm SYSTEM.json --mode J --numeric (--a0 A | --energy E) --eps EPS [--format json]``
+    The same NNM by shooting on the exact flow: frequency, period, release state, Floquet multipliers.
 ``lindstedt derive NAME [--order N] [--format text|latex|json] [--output DIR]`` / ``lindstedt derive --list``
     Named derivations (Duffing, u_+, gaps, grazing, NNMs, all modes).
 ``lindstedt demo``
@@ -66,7 +68,10 @@ def build_parser() -> argparse.ArgumentParser:
     nnm = commands.add_parser("nnm", help="nonlinear normal mode of M X'' + K X + eps W (A X - b)_+ = 0 by strained coordinates")
     nnm.add_argument("system", help="SYSTEM.json with keys M, K, A, b and optional W (nested lists, numbers or exact strings)")
     nnm.add_argument("--mode", type=int, required=True, help="mode number j (1-based, increasing frequency)")
-    nnm.add_argument("--a0", required=True, help="modal amplitude of mode j at release")
+    nnm.add_argument("--a0", default=None, help="modal amplitude of mode j at release (expansion, or --numeric with the other modal coordinates free)")
+    nnm.add_argument("--numeric", action="store_true", help="periodic orbit by shooting on the exact flow instead of the expansion")
+    nnm.add_argument("--energy", default=None, help="with --numeric: prescribed energy instead of --a0")
+    nnm.add_argument("--eps", default=None, help="with --numeric: the value of epsilon")
     nnm.add_argument("--order", type=int, default=2, help="expansion order (default 2)")
     nnm.add_argument("--precision", type=int, default=30, help="decimal digits of the arithmetic (default 30)")
     nnm.add_argument("--format", choices=("text", "latex", "json"), default="text")
@@ -120,6 +125,10 @@ def _command_nnm(arguments: argparse.Namespace) -> str:
     except (OSError, json.JSONDecodeError) as error:
         raise ProblemError(f"cannot read the system file {arguments.system!r}: {error}") from None
     system = UnilateralSystem.from_json_dict(data)
+    if arguments.numeric:
+        return _numeric_nnm(system, arguments)
+    if arguments.a0 is None:
+        raise ProblemError("give --a0 (the modal amplitude of the mode), or --numeric with --energy")
     result = nnm(system, arguments.mode, parse_number(arguments.a0, what="a0"), arguments.order, precision=arguments.precision)
     if arguments.format == "json":
         return result.to_json()
@@ -138,6 +147,41 @@ def _command_derive(arguments: argparse.Namespace) -> str:
         raise ProblemError("name a derivation (lindstedt derive --list shows them)")
     result = derive(arguments.name, order=arguments.order, output_directory=arguments.output)
     return format_derivation(result, arguments.format)
+
+
+def _numeric_nnm(system, arguments: argparse.Namespace) -> str:
+    import json
+
+    from ._errors import ProblemError
+    from ._nnm_numeric import nnm_point
+
+    if arguments.eps is None:
+        raise ProblemError("--numeric needs --eps EPS (the value of epsilon)")
+    if (arguments.a0 is None) == (arguments.energy is None):
+        raise ProblemError("--numeric needs exactly one of --a0 A (modal amplitude) and --energy E")
+    amplitude = {"modal_amplitude": float(arguments.a0)} if arguments.a0 is not None else {"energy": float(arguments.energy)}
+    result = nnm_point(system, float(arguments.eps), arguments.mode, **amplitude)
+    multipliers = [] if result.floquet_multipliers is None else [[float(z.real), float(z.imag)] for z in result.floquet_multipliers]
+    data = {
+        "schema": "lindstedt.nnm-numeric/1",
+        "success": bool(result.success),
+        "message": result.message,
+        "mode": result.mode,
+        "epsilon": result.epsilon,
+        "frequency": result.frequency,
+        "period": result.period,
+        "release_position": [float(x) for x in result.release_position],
+        "release_velocity": [float(x) for x in result.release_velocity],
+        "modal_coordinates": [float(x) for x in result.modal_coordinates],
+        "energy": result.energy,
+        "floquet_multipliers": multipliers,
+        "stable": result.stable,
+        "newton_iterations": result.newton_iterations,
+        "flow_evaluations": result.flow_evaluations,
+    }
+    if arguments.format == "json":
+        return json.dumps(data, indent=2)
+    return result.summary()
 
 
 def main(argv: Sequence[str] | None = None) -> int:
