@@ -34,6 +34,7 @@ REGISTRY: dict[str, tuple[str, str]] = {
     "duffing-orders": ("bench_duffing_orders", "run"),
     "unilateral": ("bench_unilateral", "run"),
     "nnm-branch": ("bench_nnm_branch", "run"),
+    "nnm-scaling": ("bench_nnm_scaling", "run"),
 }
 
 
