@@ -22,7 +22,7 @@ from ._errors import (
     ResonanceError,
     UnsupportedNonlinearityError,
 )
-from ._expansion import Expansion, PiecewiseWaveform, Waveform
+from ._expansion import Expansion, ExpansionValidityWarning, PiecewiseWaveform, Waveform
 from ._flow import ExactFlow
 from ._hierarchy import LindstedtPoincare
 from ._nnm_expansion import NNMExpansion, StrainedCoordinatesNNM, nnm
@@ -68,6 +68,7 @@ __all__ = [
     "exact_spectrum",
     "LindstedtPoincare",
     "Expansion",
+    "ExpansionValidityWarning",
     "Waveform",
     "PiecewiseWaveform",
     "generate_code",

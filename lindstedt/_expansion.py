@@ -32,6 +32,7 @@ JSON schema ``lindstedt.expansion/1`` (:meth:`Expansion.to_dict`)::
 from __future__ import annotations
 
 import json
+import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any, Callable, Mapping
@@ -45,7 +46,11 @@ from ._hierarchy import MAX_ORDER, SmoothHierarchy
 from ._piecewise_hierarchy import PiecewiseHierarchy
 from ._problem import Oscillator
 
-__all__ = ["Expansion", "Waveform", "PiecewiseWaveform", "STRAINED_TIME", "EPSILON", "TIME"]
+__all__ = ["Expansion", "ExpansionValidityWarning", "Waveform", "PiecewiseWaveform", "STRAINED_TIME", "EPSILON", "TIME"]
+
+
+class ExpansionValidityWarning(UserWarning):
+    """A numeric evaluation outside the range where the truncated series is meaningful."""
 
 STRAINED_TIME = sympy.Symbol("s", real=True)
 EPSILON = sympy.Symbol("epsilon", real=True)
@@ -324,8 +329,36 @@ class Expansion:
         """
         order = self.order if order is None else order
         coefficients = self._floats([self.omega_correction(k) for k in range(order + 1)], values)
-        result = np.polynomial.polynomial.polyval(np.asarray(epsilon, dtype=float), coefficients)
+        points = np.asarray(epsilon, dtype=float)
+        result = np.polynomial.polynomial.polyval(points, coefficients)
+        if order >= 1:
+            next_term = self.truncation_error_estimate(points, values, order=order)
+            correction = np.abs(result - coefficients[0])
+            if np.any(next_term > np.maximum(correction, 1e-300)):
+                warnings.warn(
+                    ExpansionValidityWarning(
+                        f"at eps = {np.max(np.abs(points)):.3g} the next term omega_{order + 1} eps^{order + 1} is larger than "
+                        "the whole correction: the series is not converging there; use a smaller eps or a numerical "
+                        "method (lindstedt.reference_solution, lindstedt.nnm_point)"
+                    ),
+                    stacklevel=2,
+                )
         return float(result) if np.ndim(result) == 0 else result
+
+    def truncation_error_estimate(self, epsilon: Any, values: Mapping[Any, Any] | None = None, *, order: int | None = None) -> Any:
+        """|ω_{order+1} ε^{order+1}|: the size of the first neglected term of ω(ε) (vectorised).
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> e = lindstedt.expand("u**3", order=1, a0=1, omega0=1)
+        >>> round(float(e.truncation_error_estimate(0.1)), 12)     # |omega_2| eps^2 = 21/256 * 0.01
+        0.0008203125
+        """
+        order = self.order if order is None else order
+        (coefficient,) = self._floats([self.omega_correction(order + 1)], values)
+        points = np.asarray(epsilon, dtype=float)
+        return np.abs(coefficient * points ** (order + 1))
 
     def _combined_coefficients(self, epsilon: float, values: Mapping[Any, Any] | None) -> tuple[np.ndarray, np.ndarray, float]:
         combined: dict[int, float] = {}
