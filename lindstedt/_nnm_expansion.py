@@ -513,6 +513,54 @@ class NNMExpansion:
         coefficients = np.array([float(w) for w in self.omega])
         return np.polynomial.polynomial.polyval(np.asarray(epsilon, dtype=float), coefficients)
 
+    def modal_displacement(self, t: Any, epsilon: float) -> np.ndarray:
+        """Modal coordinates U(t) ≈ a0 Σ_{n<N} ε̂^n W_n(ω t), ω through ω_N (shape ``t.shape + (N_dof,)``).
+
+        The branches are used between the *moving* contact angles s_i*(ε); with the
+        frequency through ω_N and the waveforms through order N−1 the error is O(ε^N)
+        on t ≤ C/ε (Theorem 4.1 for N = 2: u = v⁰ + ε v¹ + O(ε²)).
+        """
+        hierarchy = self._hierarchy
+        lam = float(self.omega[0])
+        scaled = float(epsilon) / (lam * lam)
+        frequency = float(self.frequency(epsilon))
+        times = np.asarray(t, dtype=float)
+        strained = np.mod(times * frequency + np.pi, 2 * np.pi) - np.pi
+        folded = np.abs(strained)
+        boundaries = np.array(
+            [sum(float(hierarchy._shifts[n][index]) * scaled**n for n in range(max(self.order, 1))) for index in range(len(hierarchy.boundaries))]
+        )
+        piece_index = np.searchsorted(boundaries, folded)
+        result = np.zeros(times.shape + (hierarchy.size,))
+        for piece in range(len(hierarchy.pieces)):
+            mask = piece_index == piece
+            if not np.any(mask):
+                continue
+            points = folded[mask]
+            for order in range(max(self.order, 1)):
+                weight = self.a0 * scaled**order
+                for component, branch in enumerate(hierarchy.branches(order)[piece]):
+                    total = np.zeros_like(points)
+                    for (harmonic, parity, power), value in branch.terms.items():
+                        argument = float(harmonic) * points
+                        trig = np.cos(argument) if parity == 0 else np.sin(argument)
+                        total = total + float(value) * points**power * trig
+                    result[mask, component] += weight * total
+        return result
+
+    def displacement(self, t: Any, epsilon: float) -> np.ndarray:
+        """Physical X(t) = Φ U(t) of :meth:`modal_displacement` (shape ``t.shape + (N_dof,)``).
+
+        Examples
+        --------
+        >>> import lindstedt, numpy as np
+        >>> chain = lindstedt.UnilateralSystem.chain(2, unilateral=[(0, 0)])
+        >>> mode = lindstedt.nnm(chain, mode=1, a0=1.0)
+        >>> np.allclose(mode.displacement(0.0, 0.01), mode.release_state(0.01))
+        True
+        """
+        return self.modal_displacement(t, epsilon) @ self.system.modes().shapes.T
+
     def release_state(self, epsilon: float) -> np.ndarray:
         """Physical release X(0) = Φ U(0), U_j(0) = a0 + ε a1, U_k(0) = ε a_k (velocities zero)."""
         modes = self.system.modes()

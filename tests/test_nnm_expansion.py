@@ -178,3 +178,18 @@ def test_bad_nnm_arguments():
         lindstedt.nnm(system, mode=0, a0=1)
     with pytest.raises(ProblemError, match="a0 = 0"):
         lindstedt.nnm(system, mode=1, a0=0)
+
+
+@pytest.mark.parametrize("mode", [1, 2])
+def test_nnm_waveform_error_is_second_order_over_one_over_epsilon(mode):
+    # Theorem 4.1: X(t) = Φ[v⁰ + ε v¹](ω t) + O(ε²) on t ≤ C/ε, released at the expansion's own release state
+    system = UnilateralSystem.chain(3, unilateral=[(0, 0.1), (2, -0.05)])
+    expansion = lindstedt.nnm(system, mode=mode, a0=1.0, order=2)
+    scale = float(expansion.omega[0]) ** 2
+    epsilons = np.geomspace(0.01, 0.04, 4) * scale
+    errors = []
+    for epsilon in epsilons:
+        times = np.linspace(0, 1 / epsilon, 3000)
+        exact, _ = ExactFlow(system, epsilon).solve(expansion.release_state(epsilon), np.zeros(3), times[-1]).state(times)
+        errors.append(np.max(np.abs(expansion.displacement(times, epsilon) - exact)))
+    assert np.polyfit(np.log(epsilons), np.log(errors), 1)[0] == pytest.approx(2, abs=0.3)
