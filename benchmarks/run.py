@@ -35,6 +35,7 @@ REGISTRY: dict[str, tuple[str, str]] = {
     "unilateral": ("bench_unilateral", "run"),
     "nnm-branch": ("bench_nnm_branch", "run"),
     "nnm-scaling": ("bench_nnm_scaling", "run"),
+    "method-pairs": ("bench_method_pairs", "run"),
 }
 
 

@@ -328,11 +328,11 @@ class Expansion:
             Truncation order (default: the expansion's order).
         """
         order = self.order if order is None else order
-        coefficients = self._floats([self.omega_correction(k) for k in range(order + 1)], values)
+        coefficients = self._frequency_coefficients(order + 1, values)
         points = np.asarray(epsilon, dtype=float)
-        result = np.polynomial.polynomial.polyval(points, coefficients)
+        result = np.polynomial.polynomial.polyval(points, coefficients[: order + 1])
         if order >= 1:
-            next_term = self.truncation_error_estimate(points, values, order=order)
+            next_term = np.abs(coefficients[order + 1] * points ** (order + 1))
             correction = np.abs(result - coefficients[0])
             if np.any(next_term > np.maximum(correction, 1e-300)):
                 warnings.warn(
@@ -356,9 +356,20 @@ class Expansion:
         0.0008203125
         """
         order = self.order if order is None else order
-        (coefficient,) = self._floats([self.omega_correction(order + 1)], values)
+        coefficient = self._frequency_coefficients(order + 1, values)[order + 1]
         points = np.asarray(epsilon, dtype=float)
         return np.abs(coefficient * points ** (order + 1))
+
+    @cached_property
+    def _float_cache(self) -> dict[Any, np.ndarray]:
+        return {}
+
+    def _frequency_coefficients(self, highest: int, values: Mapping[Any, Any] | None) -> np.ndarray:
+        """Float ω_0..ω_highest for these values (cached: repeated evaluations cost microseconds)."""
+        key = (highest, tuple(sorted((str(k), str(v)) for k, v in (values or {}).items())))
+        if key not in self._float_cache:
+            self._float_cache[key] = self._floats([self.omega_correction(k) for k in range(highest + 1)], values)
+        return self._float_cache[key]
 
     def _combined_coefficients(self, epsilon: float, values: Mapping[Any, Any] | None) -> tuple[np.ndarray, np.ndarray, float]:
         combined: dict[int, float] = {}
