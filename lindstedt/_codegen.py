@@ -134,6 +134,8 @@ def generate_code(expansion: Any, quantity: str = "frequency", language: str = "
     >>> code.arguments
     ('epsilon', 'a0', 'omega0')
     """
+    if not hasattr(expansion, "frequency_expr"):  # an N-dof NNM: numeric coefficients, no free parameters
+        return _nnm_code(expansion, quantity, language)
     coefficient = _coefficient_index(quantity)
     if quantity not in _QUANTITIES and coefficient is None:
         raise ValueError(f"quantity must be one of {_QUANTITIES} or 'omega<k>' (e.g. 'omega2')")
@@ -193,6 +195,24 @@ def _horner_form(expression: sympy.Expr, variable: sympy.Symbol) -> sympy.Expr:
     except sympy.PolynomialError:
         return expression
     return nested.xreplace(dict(zip(placeholders, atoms)))
+
+
+def _nnm_code(result: Any, quantity: str, language: str) -> GeneratedCode:
+    from ._expansion import EPSILON
+
+    if quantity != "frequency":
+        raise ValueError(
+            "for an N-dof NNM only quantity='frequency' is generated (its waveform is vector valued: "
+            "use NNMExpansion.displacement)"
+        )
+    if language not in _LANGUAGES:
+        raise ValueError(f"language must be one of {_LANGUAGES}")
+    digits = result._hierarchy.digits
+    expression = sympy.Add(*[sympy.Float(str(value), digits) * EPSILON**n for n, value in enumerate(result.omega)])
+    expression = _horner_form(expression, EPSILON)
+    name = "lindstedt_frequency"
+    source = (_numpy_source if language == "numpy" else _c_source)(name, [EPSILON], EPSILON, expression)
+    return GeneratedCode(language, quantity, name, ("epsilon",), source)
 
 
 def _coefficient_index(quantity: str) -> int | None:

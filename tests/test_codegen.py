@@ -47,3 +47,14 @@ def test_bad_arguments():
         lindstedt.generate_code(expansion, "energy")
     with pytest.raises(ValueError, match="language"):
         lindstedt.generate_code(expansion, "frequency", "fortran")
+
+
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_nnm_frequency_code_round_trip(language):
+    chain = lindstedt.UnilateralSystem.chain(3, unilateral=[(0, 0.1)])
+    result = lindstedt.nnm(chain, mode=2, a0=1.0, order=3)
+    code = lindstedt.generate_code(result, "frequency", language)
+    epsilons = np.linspace(0, 0.05, 11)
+    assert np.max(np.abs(code.compile()(epsilons) - result.frequency(epsilons))) < 1e-13
+    with pytest.raises(ValueError, match="vector valued"):
+        lindstedt.generate_code(result, "displacement", language)
