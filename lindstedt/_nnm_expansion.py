@@ -49,7 +49,7 @@ from sympy import RealField
 
 from ._branch import Branch, EvaluationPoint
 from ._errors import ProblemError, ResonanceError
-from ._series_algebra import extend_square_root, shift_powers
+from ._series_algebra import LazyOrders, shift_powers
 from ._system import UnilateralSystem
 
 __all__ = ["NNMExpansion", "StrainedCoordinatesNNM", "nnm", "release_amplitudes_by_series"]
@@ -125,7 +125,7 @@ class _Affine:
         return total
 
 
-class _ModalHierarchy:
+class _ModalHierarchy(LazyOrders):
     """Order-by-order NNM hierarchy (see the module docstring)."""
 
     def __init__(self, system: UnilateralSystem, mode: int, amplitude: Any, release_correction: Any, digits: int):
@@ -134,6 +134,7 @@ class _ModalHierarchy:
         self.digits = digits
         domain = RealField(dps=digits)
         self.domain = domain
+        self._domain = domain
         size = system.n_dof
         self.size = size
         frequencies, shapes = _modes_high_precision(system, digits + 10)
@@ -162,7 +163,7 @@ class _ModalHierarchy:
             [[Branch.cosine(domain) if k == mode else Branch(domain) for k in range(size)] for _ in self.pieces]
         ]
         self._squared = [domain.one]
-        self._frequency_terms = [domain.one]
+        self._frequencies = [domain.one]
         self._shifts: list[list[Any]] = [[boundary.point.value for boundary in self.boundaries]]
         self._derivatives: dict[tuple[int, int, int, int], Branch] = {}
 
@@ -391,19 +392,6 @@ class _ModalHierarchy:
         self._branches.append(branches)
         self._squared.append(unknowns[0])
         self._shifts.append([value.value(unknowns) for value in shift_values])
-
-    def _ensure(self, order: int) -> None:
-        while len(self._squared) <= order:
-            self._solve_order(len(self._squared))
-
-    def squared_frequency(self, order: int) -> Any:
-        """A_order (normalised ε̂^order coefficient of Ω²)."""
-        self._ensure(order)
-        return self._squared[order]
-
-    def frequency(self, order: int) -> Any:
-        """Ω_order."""
-        return extend_square_root(self._frequency_terms, self.squared_frequency, order, self.domain)
 
     def release(self, order: int, component: int) -> Any:
         """W_{order, component}(0)."""

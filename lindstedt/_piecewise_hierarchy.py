@@ -45,7 +45,7 @@ from ._branch import Branch, EvaluationPoint
 from ._errors import ProblemError
 from ._piecewise_linear import LinearInterval, decompose_piecewise_linear
 from ._problem import DISPLACEMENT, Oscillator
-from ._series_algebra import extend_square_root, shift_powers
+from ._series_algebra import LazyOrders, shift_powers
 
 __all__ = ["ContactBoundary", "PiecewiseNormalForm", "PiecewiseHierarchy", "piecewise_normal_form"]
 
@@ -303,7 +303,7 @@ class _Affine:
         return self.base + self.a * a_value + self.c * c_value
 
 
-class PiecewiseHierarchy:
+class PiecewiseHierarchy(LazyOrders):
     """Order-by-order solution of the piecewise problem (same interface as the smooth hierarchy).
 
     Examples
@@ -470,20 +470,7 @@ class PiecewiseHierarchy:
             total = total.shift(self._boundary_first_harmonic(index, order, self._shift_powers(index, order)))
         return total
 
-    # -- public interface (mirrors SmoothHierarchy) ------------------------------------------------
-    def _ensure(self, order: int) -> None:
-        while len(self._squared) <= order:
-            self._solve_order(len(self._squared))
-
-    def squared_frequency(self, order: int) -> Any:
-        """A_order: coefficient of ε̂^order in Ω²."""
-        self._ensure(order)
-        return self._squared[order]
-
-    def frequency(self, order: int) -> Any:
-        """Ω_order: coefficient of ε̂^order in Ω."""
-        return extend_square_root(self._frequencies, self.squared_frequency, order, self._domain)
-
+    # -- public interface (mirrors SmoothHierarchy; squared_frequency/frequency from LazyOrders) ----
     def branches(self, order: int) -> list[Branch]:
         """W_order on each piece (analytic branches)."""
         self._ensure(order)

@@ -10,7 +10,7 @@ from typing import Any, Callable
 
 from sympy import Rational
 
-__all__ = ["extend_square_root", "shift_powers"]
+__all__ = ["LazyOrders", "extend_square_root", "shift_powers"]
 
 
 def extend_square_root(roots: list[Any], squared: Callable[[int], Any], order: int, domain: Any) -> Any:
@@ -49,3 +49,28 @@ def shift_powers(shifts: list[Any], order: int, domain: Any) -> list[list[Any]]:
         previous = powers[-1]
         powers.append([sum((previous[j - i] * padded[i] for i in range(1, j + 1)), zero) for j in range(order + 1)])
     return powers
+
+
+class LazyOrders:
+    """Mixin for hierarchies solved order by order on demand.
+
+    The host defines ``_solve_order(n)`` (which appends A_n to ``_squared``),
+    ``_squared = [1]``, ``_frequencies = [1]`` and ``_domain``.
+    """
+
+    _squared: list[Any]
+    _frequencies: list[Any]
+    _domain: Any
+
+    def _ensure(self, order: int) -> None:
+        while len(self._squared) <= order:
+            self._solve_order(len(self._squared))  # type: ignore[attr-defined]  # defined by the host class
+
+    def squared_frequency(self, order: int) -> Any:
+        """A_order: coefficient of ε̂^order in Ω² (Ω = ω/ω_0)."""
+        self._ensure(order)
+        return self._squared[order]
+
+    def frequency(self, order: int) -> Any:
+        """Ω_order: coefficient of ε̂^order in Ω = sqrt(Σ A_k ε̂^k)."""
+        return extend_square_root(self._frequencies, self.squared_frequency, order, self._domain)
