@@ -190,7 +190,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     Examples
     --------
     >>> main(["expand", "u**3", "--order", "1", "--a0", "1", "--omega0", "1"])
-    u'' + 1**2*u + eps*(u**3) = 0, u(0) = 1 [initial]
+    u'' + u + eps*(u**3) = 0, u(0) = 1 [initial]
       omega_0 = 1
       omega_1 = 3/8
     0

@@ -261,7 +261,10 @@ class Oscillator:
         """One-line human description of the problem."""
         params = ", ".join(f"{symbol} = {value}" for symbol, value in self.params if value != symbol)
         symbolic = ", ".join(str(symbol) for symbol in self.symbolic_parameters)
-        text = f"u'' + {self.omega0}**2*u + eps*({self.f}) = 0, u(0) = {self.a0} [{self.normalization}]"
+        squared = self.omega0**2
+        stiffness = f"({sympy.sstr(squared)})" if isinstance(squared, sympy.Add) else sympy.sstr(squared)
+        stiffness_term = "u" if squared == 1 else f"{stiffness}*u"
+        text = f"u'' + {stiffness_term} + eps*({self.f}) = 0, u(0) = {self.a0} [{self.normalization}]"
         if params:
             text += f"; {params}"
         if symbolic:
