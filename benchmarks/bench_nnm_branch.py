@@ -306,7 +306,6 @@ def run(quick: bool = False) -> str:
         increment = (case["stop"] - case["start"]) / max(arclength["points"] - 1, 1)
         _log(f"branch: {case['name']} (seed, {arclength['points']} points)")
         seed = _call("branch", {**case, "method": "seed", "increment": increment})
-        import numpy as np  # parent process: comparison only
 
         cross = None
         if seed["points"] >= 2 and arclength["points"] >= 4:

@@ -23,7 +23,7 @@ and u_k = O(ε), k ≠ j, on [0, 1/ε]: that case is the NNM of mode j
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Sequence
 
 import numpy as np
 

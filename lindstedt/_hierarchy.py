@@ -43,7 +43,7 @@ from typing import Any, Callable
 
 import mpmath
 import sympy
-from sympy import QQ, Rational, RealField
+from sympy import QQ, RealField
 
 from ._cosine import CosineSeries, solve_harmonic_oscillator, sum_series
 from ._errors import OrderError, ProblemError, UnsupportedNonlinearityError

@@ -43,7 +43,7 @@ from sympy import QQ, RealField
 
 from ._branch import Branch, EvaluationPoint
 from ._errors import ProblemError
-from ._piecewise_linear import LinearInterval, decompose_piecewise_linear
+from ._piecewise_linear import decompose_piecewise_linear
 from ._problem import DISPLACEMENT, Oscillator
 from ._series_algebra import LazyOrders, shift_powers
 

@@ -489,7 +489,7 @@ def frequency_taylor_coefficients(
         raise OrderError(f"order {order} is too high for the Chebyshev reference (at most 24)")
     dps = validate_dps(dps)
     potential = _Potential(f)
-    coarse_nodes, fine_nodes = 32, 64
+    fine_nodes = 64  # the coarse grid is every other node (33 points)
     working_dps = dps + 15
     with mpmath.workdps(working_dps):
         a0_value = real_parameter(a0, "a0")
