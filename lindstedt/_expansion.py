@@ -361,56 +361,72 @@ class Expansion:
         return np.abs(coefficient * points ** (order + 1))
 
     @cached_property
-    def _float_cache(self) -> dict[Any, np.ndarray]:
+    def _float_cache(self) -> dict[Any, Any]:
         return {}
+
+    def _cached(self, tag: Any, values: Mapping[Any, Any] | None, compute: Any) -> Any:
+        """Float data that depends only on the parameter values, computed once per values (ε-independent)."""
+        key = (tag, tuple(sorted((str(k), str(v)) for k, v in (values or {}).items())))
+        if key not in self._float_cache:
+            self._float_cache[key] = compute()
+        return self._float_cache[key]
 
     def _frequency_coefficients(self, highest: int, values: Mapping[Any, Any] | None) -> np.ndarray:
         """Float ω_0..ω_highest for these values (cached: repeated evaluations cost microseconds)."""
-        key = (highest, tuple(sorted((str(k), str(v)) for k, v in (values or {}).items())))
-        if key not in self._float_cache:
-            self._float_cache[key] = self._floats([self.omega_correction(k) for k in range(highest + 1)], values)
-        return self._float_cache[key]
+        return self._cached(("omega", highest), values, lambda: self._floats([self.omega_correction(k) for k in range(highest + 1)], values))
+
+    def _waveform_floats(self, values: Mapping[Any, Any] | None) -> tuple[list[tuple[int, int]], np.ndarray]:
+        """(order, harmonic) keys and float coefficients of v_0..v_N (smooth f)."""
+
+        def compute() -> tuple[list[tuple[int, int]], np.ndarray]:
+            keys = [(waveform.order, harmonic) for waveform in self.waveforms for harmonic, _ in waveform.coefficients]
+            expressions = [value for waveform in self.waveforms for _, value in waveform.coefficients]
+            return keys, self._floats(expressions, values)
+
+        return self._cached("waveforms", values, compute)
 
     def _combined_coefficients(self, epsilon: float, values: Mapping[Any, Any] | None) -> tuple[np.ndarray, np.ndarray, float]:
         combined: dict[int, float] = {}
-        expressions: list[sympy.Expr] = []
-        keys: list[tuple[int, int]] = []
-        for waveform in self.waveforms:
-            for harmonic, value in waveform.coefficients:
-                expressions.append(value)
-                keys.append((waveform.order, harmonic))
-        numbers = self._floats(expressions, values)
+        keys, numbers = self._waveform_floats(values)
         for (order, harmonic), number in zip(keys, numbers):
             combined[harmonic] = combined.get(harmonic, 0.0) + number * epsilon**order
-        omegas = self._floats(list(self.omega) + [self.omega_next], values)
-        frequency = float(np.polynomial.polynomial.polyval(epsilon, omegas))
+        frequency = float(np.polynomial.polynomial.polyval(epsilon, self._frequency_coefficients(self.order + 1, values)))
         harmonics = np.array(sorted(combined), dtype=float)
         return harmonics, np.array([combined[int(h)] for h in harmonics]), frequency
 
-    def _piecewise_float_data(self, epsilon: float, values: Mapping[Any, Any] | None):
-        substitution = self._substitution(values)
-        form = self._hierarchy.form
+    def _piecewise_floats(self, values: Mapping[Any, Any] | None) -> tuple[float, float, list, list]:
+        """ε̂/ε, a0, per-order per-piece float branch terms and per-order boundary shifts (piecewise f)."""
 
-        def to_float(element: Any, scale: sympy.Expr) -> float:
-            return float((scale * form.to_expr(element)).xreplace(substitution))
+        def compute() -> tuple[float, float, list, list]:
+            substitution = self._substitution(values)
+            form = self._hierarchy.form
 
-        scale_value = float(self._scale.xreplace(substitution)) * epsilon
-        amplitude = float(self.problem.a0.xreplace(substitution))
-        pieces: list[dict[tuple[int, int, int], float]] = [dict() for _ in form.piece_coefficients]
-        for order in range(self.order + 1):
-            weight = amplitude * scale_value**order
-            for piece, branch in enumerate(self._hierarchy.branches(order)):
-                for key, element in branch.terms.items():
-                    pieces[piece][key] = pieces[piece].get(key, 0.0) + weight * to_float(element, sympy.Integer(1))
-        boundaries = []
-        for index in range(len(form.boundaries)):
-            position = sum(
-                to_float(self._hierarchy.boundary_shift(order)[index], sympy.Integer(1)) * scale_value**order
+            def to_float(element: Any) -> float:
+                return float(form.to_expr(element).xreplace(substitution))
+
+            branch_terms = [
+                [{key: to_float(element) for key, element in branch.terms.items()} for branch in self._hierarchy.branches(order)]
                 for order in range(self.order + 1)
-            )
-            boundaries.append(position)
-        omegas = self._floats(list(self.omega) + [self.omega_next], values)
-        frequency = float(np.polynomial.polynomial.polyval(epsilon, omegas))
+            ]
+            shifts = [[to_float(value) for value in self._hierarchy.boundary_shift(order)] for order in range(self.order + 1)]
+            return float(self._scale.xreplace(substitution)), float(self.problem.a0.xreplace(substitution)), branch_terms, shifts
+
+        return self._cached("piecewise", values, compute)
+
+    def _piecewise_float_data(self, epsilon: float, values: Mapping[Any, Any] | None):
+        scale, amplitude, branch_terms, shifts = self._piecewise_floats(values)
+        scale_value = scale * epsilon
+        pieces: list[dict[tuple[int, int, int], float]] = [dict() for _ in self._hierarchy.form.piece_coefficients]
+        for order, order_terms in enumerate(branch_terms):
+            weight = amplitude * scale_value**order
+            for piece, terms in enumerate(order_terms):
+                for key, value in terms.items():
+                    pieces[piece][key] = pieces[piece].get(key, 0.0) + weight * value
+        boundaries = [
+            sum(shifts[order][index] * scale_value**order for order in range(self.order + 1))
+            for index in range(len(self._hierarchy.form.boundaries))
+        ]
+        frequency = float(np.polynomial.polynomial.polyval(epsilon, self._frequency_coefficients(self.order + 1, values)))
         terms = [[(j, parity, power, value) for (j, parity, power), value in piece.items()] for piece in pieces]
         return np.array(boundaries), terms, frequency
 
