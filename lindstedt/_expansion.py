@@ -41,7 +41,7 @@ import numpy as np
 import sympy
 
 from ._errors import OrderError
-from ._branch import Branch, EvaluationPoint
+from ._branch import Branch, EvaluationPoint, evaluate_float_terms
 from ._hierarchy import MAX_ORDER, SmoothHierarchy
 from ._piecewise_hierarchy import PiecewiseHierarchy
 from ._problem import Oscillator
@@ -114,14 +114,6 @@ def _fold(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Reduce s to [0, π] using evenness and 2π-periodicity; also the sign of d/ds."""
     shifted = np.mod(s + np.pi, 2 * np.pi) - np.pi
     return np.abs(shifted), np.where(shifted < 0, -1.0, 1.0)
-
-
-def _branch_float_terms(branch_terms: list[tuple[int, int, int, float]], s: np.ndarray) -> np.ndarray:
-    total = np.zeros_like(s)
-    for harmonic, parity, power, value in branch_terms:
-        trig = np.cos(harmonic * s) if parity == 0 else np.sin(harmonic * s)
-        total = total + value * s**power * trig
-    return total
 
 
 @dataclass(frozen=True)
@@ -448,9 +440,9 @@ class Expansion:
                         derived.append((harmonic, parity, power - 1, value * power))
                     if harmonic:
                         derived.append((harmonic, 1 - parity, power, value * harmonic * (-1 if parity == 0 else 1)))
-                result[mask] = _branch_float_terms(derived, folded[mask]) * sign[mask] * frequency
+                result[mask] = evaluate_float_terms(derived, folded[mask]) * sign[mask] * frequency
             else:
-                result[mask] = _branch_float_terms(piece_terms, folded[mask])
+                result[mask] = evaluate_float_terms(piece_terms, folded[mask])
         return result if result.ndim else float(result)
 
     def displacement(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None = None) -> np.ndarray:

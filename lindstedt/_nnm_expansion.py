@@ -46,7 +46,7 @@ import numpy as np
 import sympy
 from sympy import RealField
 
-from ._branch import Branch, EvaluationPoint
+from ._branch import Branch, EvaluationPoint, evaluate_float_terms
 from ._errors import ProblemError, ResonanceError
 from ._series_algebra import LazyOrders, shift_powers
 from ._system import UnilateralSystem
@@ -527,12 +527,8 @@ class NNMExpansion:
             for order in range(max(self.order, 1)):
                 weight = self.a0 * scaled**order
                 for component, branch in enumerate(hierarchy.branches(order)[piece]):
-                    total = np.zeros_like(points)
-                    for (harmonic, parity, power), value in branch.terms.items():
-                        argument = float(harmonic) * points
-                        trig = np.cos(argument) if parity == 0 else np.sin(argument)
-                        total = total + float(value) * points**power * trig
-                    result[mask, component] += weight * total
+                    terms = [(frequency, parity, power, float(value)) for (frequency, parity, power), value in branch.terms.items()]
+                    result[mask, component] += weight * evaluate_float_terms(terms, points)
         return result
 
     def displacement(self, t: Any, epsilon: float) -> np.ndarray:
