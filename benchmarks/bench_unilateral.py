@@ -656,7 +656,7 @@ def run(quick: bool = False) -> str:
       f"array of 10⁶ κ uniform in (−1, 1); each function timed {config['codegen_repeats']}× interleaved with the "
       "baseline `np.arccos(x) + np.sqrt(1 - x*x)` (min). Generation + compilation: "
       f"NumPy {_s(codegen['generate_seconds']['numpy'])}, C {_s(codegen['generate_seconds']['c'])} (the C build is "
-      f"cached by source hash in the temp directory, so this may be a cache hit); symbolic derivation first: "
+      f"cached by source hash in the per-user cache directory, so this may be a cache hit); symbolic derivation first: "
       f"{_s(codegen['derive_seconds'])}.")
     w("")
     w("| 10⁶ κ | time (min) | per κ | ratio to arccos+sqrt |")
