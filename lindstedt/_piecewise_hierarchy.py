@@ -76,6 +76,12 @@ class PiecewiseNormalForm:
     zero_point: EvaluationPoint
     pi_point: EvaluationPoint
     prune_tolerance: float | None = None
+    # The assumptions of the derivation (read by Expansion to check numeric ``values``):
+    # the sign of a0 it was derived for, and every w-breakpoint κ (increasing) with where it
+    # lies relative to the orbit [-1, 1]: "crossing" (|κ| < 1, decided or assumed), "grazing"
+    # (|κ| = 1), "above" (κ > 1: never reached) or "below" (κ < -1: permanent contact).
+    amplitude_sign: int = 1
+    breakpoint_classes: tuple[tuple[sympy.Expr, str], ...] = ()
 
     def to_expr(self, element: Any) -> sympy.Expr:
         """Domain element -> sympy expression with generators substituted."""
@@ -119,7 +125,7 @@ class _ConstantField:
                 self.generators.append((generator, atom))
 
     def convert(self, value: sympy.Expr) -> Any:
-        value = sympy.sympify(value)
+        value = sympy.sympify(value, strict=True)
         if self.numeric:
             return self.domain.convert(sympy.N(value, self.digits + 10))
         if value.is_Rational:
@@ -206,6 +212,7 @@ def piecewise_normal_form(problem: Oscillator, digits: int | None = None, order_
     kappas = [upper for (_, upper, _, _) in w_intervals[:-1]]
     crossing: list[int] = []
     grazing: list[sympy.Expr] = []
+    classes: list[tuple[sympy.Expr, str]] = []
     for index, kappa in enumerate(kappas):
         below, above = _compare(kappa, -1), _compare(kappa, 1)
         if below is None or above is None:
@@ -214,11 +221,16 @@ def piecewise_normal_form(problem: Oscillator, digits: int | None = None, order_
                     f"cannot decide whether the breakpoint kappa = {kappa} lies inside (-1, 1); give numeric gaps"
                 )
             crossing.append(index)  # a single symbolic gap: the contact case |kappa| < 1 is assumed
+            classes.append((kappa, "crossing"))
             continue
         if below == 0 or above == 0:
             grazing.append(kappa)
+            classes.append((kappa, "grazing"))
         elif below > 0 and above < 0:
             crossing.append(index)
+            classes.append((kappa, "crossing"))
+        else:
+            classes.append((kappa, "above" if above > 0 else "below"))
     # Pieces in s: w_0 = cos s decreases from 1 to -1, so the crossings are met from the largest κ down.
     crossing_kappas = [kappas[i] for i in crossing]
     interval_of = []  # interval index (in w order) for each piece in s
@@ -276,6 +288,8 @@ def piecewise_normal_form(problem: Oscillator, digits: int | None = None, order_
         zero_point=zero,
         pi_point=pi_point,
         prune_tolerance=None if not field.numeric else 0.0,
+        amplitude_sign=sign,
+        breakpoint_classes=tuple(classes),
     )
 
 
