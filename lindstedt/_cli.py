@@ -15,18 +15,35 @@ Sub-commands
     The tour: derives the Duffing and unilateral-spring expansions, prints them
     and their agreement with the exact references.
 
-Errors in the input print ``error: <message naming the fix>`` and exit with status 2.
+Every failure prints one line ``error: <message naming the fix>`` on stderr and exits
+non-zero: 2 for bad input (arguments, files, values outside what a method takes),
+1 for a computation that failed (a numerical method that did not converge, an
+unexpected internal error).  JSON output never contains NaN or infinities: a
+failed numerical result has ``null`` values with ``"success": false`` and a message.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
-from typing import Sequence
+from typing import Any, Sequence
 
-from ._errors import LindstedtError
+from ._errors import ConvergenceError, LindstedtError, ProblemError
 
 __all__ = ["main", "build_parser"]
+
+EXIT_BAD_INPUT = 2
+EXIT_FAILED = 1
+
+
+class _InputError(Exception):
+    """Raised by the argument parser instead of printing usage and exiting."""
+
+
+class _ArgumentParser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # type: ignore[override]
+        raise _InputError(f"{message} (see {self.prog} --help)")
 
 
 def _parse_parameters(items: Sequence[str]) -> dict[str, str | None]:
@@ -42,11 +59,18 @@ def _parse_parameters(items: Sequence[str]) -> dict[str, str | None]:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``lindstedt`` command."""
-    parser = argparse.ArgumentParser(
+    from importlib.metadata import PackageNotFoundError, version
+
+    parser = _ArgumentParser(
         prog="lindstedt",
         description="Exact Lindstedt-Poincare expansions of u'' + omega0^2 u + eps f(u) = 0, checked against exact references.",
     )
-    commands = parser.add_subparsers(dest="command", required=True)
+    try:
+        package_version = version("lindstedt")
+    except PackageNotFoundError:  # pragma: no cover - running from a source tree without installation
+        package_version = "unknown"
+    parser.add_argument("--version", action="version", version=f"lindstedt {package_version}")
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=_ArgumentParser)
 
     expand = commands.add_parser("expand", help="expand u'' + omega0^2 u + eps f(u) = 0 to a given order")
     expand.add_argument("f", help="the nonlinearity f(u), e.g. 'u**3' or 'u**3 + c*u**5'")
@@ -111,25 +135,27 @@ def _command_expand(arguments: argparse.Namespace) -> str:
     return text
 
 
-def _command_nnm(arguments: argparse.Namespace) -> str:
+def _command_nnm(arguments: argparse.Namespace) -> str | tuple[str, int]:
     import json
 
-    from ._errors import ProblemError
     from ._nnm_expansion import nnm
-    from ._parsing import parse_number
     from ._system import UnilateralSystem
 
     try:
         with open(arguments.system, encoding="utf-8") as handle:
-            data = json.load(handle)
-    except (OSError, json.JSONDecodeError) as error:
+            data = json.load(handle, parse_constant=_refuse_json_constant)
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as error:
         raise ProblemError(f"cannot read the system file {arguments.system!r}: {error}") from None
+    if not isinstance(data, dict):
+        raise ProblemError(f"the system file {arguments.system!r} must hold a JSON object with keys M, K, A, b (and optional W)")
     system = UnilateralSystem.from_json_dict(data)
     if arguments.numeric:
         return _numeric_nnm(system, arguments)
+    if arguments.eps is not None or arguments.energy is not None:
+        raise ProblemError("--eps and --energy go with --numeric; the expansion's coefficients do not depend on epsilon")
     if arguments.a0 is None:
         raise ProblemError("give --a0 (the modal amplitude of the mode), or --numeric with --energy")
-    result = nnm(system, arguments.mode, parse_number(arguments.a0, what="a0"), arguments.order, precision=arguments.precision)
+    result = nnm(system, arguments.mode, arguments.a0, arguments.order, precision=arguments.precision)
     if arguments.format == "json":
         return result.to_json()
     if arguments.format == "latex":
@@ -137,9 +163,12 @@ def _command_nnm(arguments: argparse.Namespace) -> str:
     return result.summary()
 
 
+def _refuse_json_constant(name: str) -> None:
+    raise ProblemError(f"the system file contains {name}; every entry must be a finite real number")
+
+
 def _command_derive(arguments: argparse.Namespace) -> str:
     from ._derive import derive, format_derivation, list_derivations
-    from ._errors import ProblemError
 
     if arguments.list:
         return "\n".join(f"{name:18s} {description}" for name, description in list_derivations())
@@ -149,39 +178,49 @@ def _command_derive(arguments: argparse.Namespace) -> str:
     return format_derivation(result, arguments.format)
 
 
-def _numeric_nnm(system, arguments: argparse.Namespace) -> str:
+def _finite_or_none(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
+
+
+def _numeric_nnm(system: Any, arguments: argparse.Namespace) -> tuple[str, int]:
     import json
 
-    from ._errors import ProblemError
     from ._nnm_numeric import nnm_point
+    from ._parsing import parse_float
 
     if arguments.eps is None:
         raise ProblemError("--numeric needs --eps EPS (the value of epsilon)")
     if (arguments.a0 is None) == (arguments.energy is None):
         raise ProblemError("--numeric needs exactly one of --a0 A (modal amplitude) and --energy E")
-    amplitude = {"modal_amplitude": float(arguments.a0)} if arguments.a0 is not None else {"energy": float(arguments.energy)}
-    result = nnm_point(system, float(arguments.eps), arguments.mode, **amplitude)
-    multipliers = [] if result.floquet_multipliers is None else [[float(z.real), float(z.imag)] for z in result.floquet_multipliers]
+    epsilon = parse_float(arguments.eps, what="--eps")
+    if arguments.a0 is not None:
+        amplitude = {"modal_amplitude": parse_float(arguments.a0, what="--a0")}
+    else:
+        amplitude = {"energy": parse_float(arguments.energy, what="--energy")}
+    result = nnm_point(system, epsilon, arguments.mode, **amplitude)
+    status = 0 if result.success else EXIT_FAILED
+    multipliers = [] if result.floquet_multipliers is None else [[_finite_or_none(z.real), _finite_or_none(z.imag)] for z in result.floquet_multipliers]
     data = {
         "schema": "lindstedt.nnm-numeric/1",
         "success": bool(result.success),
+        "status": "converged" if result.success else "failed",
         "message": result.message,
         "mode": result.mode,
         "epsilon": result.epsilon,
-        "frequency": result.frequency,
-        "period": result.period,
-        "release_position": [float(x) for x in result.release_position],
-        "release_velocity": [float(x) for x in result.release_velocity],
-        "modal_coordinates": [float(x) for x in result.modal_coordinates],
-        "energy": result.energy,
+        "frequency": _finite_or_none(result.frequency),
+        "period": _finite_or_none(result.period),
+        "release_position": [_finite_or_none(x) for x in result.release_position],
+        "release_velocity": [_finite_or_none(x) for x in result.release_velocity],
+        "modal_coordinates": [_finite_or_none(x) for x in result.modal_coordinates],
+        "energy": _finite_or_none(result.energy),
         "floquet_multipliers": multipliers,
         "stable": result.stable,
         "newton_iterations": result.newton_iterations,
         "flow_evaluations": result.flow_evaluations,
     }
     if arguments.format == "json":
-        return json.dumps(data, indent=2)
-    return result.summary()
+        return json.dumps(data, indent=2, allow_nan=False), status
+    return result.summary(), status
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -195,30 +234,47 @@ def main(argv: Sequence[str] | None = None) -> int:
       omega_1 = 3/8
     0
     """
-    parser = build_parser()
-    arguments = parser.parse_args(argv)
+    status = 0
     try:
+        arguments = build_parser().parse_args(argv)
         if arguments.command == "expand":
             output = _command_expand(arguments)
         elif arguments.command == "nnm":
             output = _command_nnm(arguments)
         elif arguments.command == "derive":
             output = _command_derive(arguments)
-        elif arguments.command == "demo":
+        else:
             from ._demo import run_demo
 
             output = run_demo(order=arguments.order, figure_path=arguments.figure or None)
-        else:  # pragma: no cover - argparse enforces the choices
-            parser.error(f"unknown command {arguments.command}")
-            return 2
+        if isinstance(output, tuple):
+            output, status = output
+    except SystemExit as exit_request:  # --help and --version print and exit 0
+        return int(exit_request.code or 0)
+    except (_InputError, ProblemError) as error:
+        return _fail(error, EXIT_BAD_INPUT)
+    except OSError as error:
+        where = f" {error.filename!r}" if error.filename else ""
+        return _fail(f"cannot access{where}: {error.strerror or error}; check that the path exists and is writable", EXIT_BAD_INPUT)
     except LindstedtError as error:
-        print(f"error: {error}", file=sys.stderr)
-        return 2
+        return _fail(error, EXIT_FAILED if isinstance(error, ConvergenceError) else EXIT_BAD_INPUT)
+    except RecursionError:
+        return _fail("the input is too deeply nested to process; simplify it", EXIT_BAD_INPUT)
+    except Exception as error:  # noqa: BLE001 - the command line never shows a traceback
+        return _fail(f"internal failure ({type(error).__name__}: {error}); please report it", EXIT_FAILED)
     try:
         print(output)
     except BrokenPipeError:  # e.g. `lindstedt expand ... | head`
         sys.stderr.close()
-    return 0
+    if status and output:
+        print("error: the computation did not succeed (see its message above)", file=sys.stderr)
+    return status
+
+
+def _fail(error: Any, status: int) -> int:
+    message = " ".join(str(error).split())  # one line
+    print(f"error: {message}", file=sys.stderr)
+    return status
 
 
 if __name__ == "__main__":  # pragma: no cover

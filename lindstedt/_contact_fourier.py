@@ -59,6 +59,7 @@ import numpy as np
 import sympy
 
 from ._errors import ConvergenceError, ProblemError
+from ._parsing import parse_real
 
 __all__ = [
     "contact_angle",
@@ -109,8 +110,10 @@ def _as_sympy_kappa(kappa: KappaLike) -> sympy.Expr:
     """Sympify ``kappa`` and check that it can be real."""
     if isinstance(kappa, Fraction):
         kappa = sympy.Rational(kappa.numerator, kappa.denominator)
+    if isinstance(kappa, str):  # user text: read by the one parser
+        return parse_real(kappa, what="kappa")
     try:
-        value = sympy.sympify(kappa)
+        value = sympy.sympify(kappa, strict=True)
     except (sympy.SympifyError, TypeError) as exc:
         raise ProblemError(f"kappa={kappa!r} is not a number or sympy expression; pass e.g. sympy.Rational(1, 3)") from exc
     if not isinstance(value, sympy.Expr):

@@ -183,13 +183,13 @@ class _Content:
 # small helpers
 # --------------------------------------------------------------------------- #
 def _latex(expression: Any) -> str:
-    expression = sympy.sympify(expression)
+    expression = sympy.sympify(expression, strict=True)
     names = {symbol: _LATEX_NAMES[symbol.name] for symbol in expression.free_symbols if symbol.name in _LATEX_NAMES}
     return sympy.latex(expression, symbol_names=names)
 
 
 def _is_number(expression: sympy.Expr) -> bool:
-    return not sympy.sympify(expression).free_symbols
+    return not sympy.sympify(expression, strict=True).free_symbols
 
 
 def _as_float(expression: sympy.Expr) -> float | None:
@@ -918,7 +918,7 @@ def derive(
     if output_directory is not None:
         directory = Path(output_directory)
         directory.mkdir(parents=True, exist_ok=True)
-        texts = {"latex": latex, "json": json.dumps(data, indent=2) + "\n"}
+        texts = {"latex": latex, "json": json.dumps(data, indent=2, allow_nan=False) + "\n"}
         for item in dict.fromkeys(formats):
             path = directory / f"{name}{_SUFFIXES[item]}"
             path.write_text(texts[item], encoding="utf-8")
@@ -942,7 +942,7 @@ def format_derivation(result: DerivationResult, format: str = "text") -> str:
     if format == "latex":
         return result.latex.rstrip("\n")
     if format == "json":
-        return json.dumps(result.json, indent=2)
+        return json.dumps(result.json, indent=2, allow_nan=False)
     if format != "text":
         raise ProblemError(f"unknown format {format!r}; choose among {list(_PRINT_FORMATS)}")
     lines = [f"{result.name} (order {result.order}): {result.description}"]

@@ -48,6 +48,7 @@ from sympy import RealField
 
 from ._branch import Branch, EvaluationPoint, evaluate_float_terms
 from ._errors import ProblemError, ResonanceError
+from ._parsing import parse_real
 from ._series_algebra import LazyOrders, shift_powers
 from ._system import UnilateralSystem
 
@@ -143,16 +144,16 @@ class _ModalHierarchy(LazyOrders):
 
         self.frequencies = [convert(value) for value in frequencies]
         self.shapes = [[convert(value) for value in column] for column in shapes]  # shapes[k][row]
-        self.amplitude = convert(sympy.sympify(amplitude))
-        self.release_correction = convert(sympy.sympify(release_correction))
+        self.amplitude = convert(amplitude)
+        self.release_correction = convert(release_correction)
         lam = self.frequencies[mode]
         self.ratios = [value / lam for value in self.frequencies]
         self.ratios[mode] = domain.one
         self._check_resonance()
         springs = system.n_springs
-        A = [[convert(sympy.sympify(v)) for v in row] for row in system.A_exact.tolist()]
-        W = [[convert(sympy.sympify(v)) for v in row] for row in system.W_exact.tolist()]
-        self.gaps = [convert(sympy.sympify(v)) for v in list(system.b_exact)]
+        A = [[convert(v) for v in row] for row in system.A_exact.tolist()]
+        W = [[convert(v) for v in row] for row in system.W_exact.tolist()]
+        self.gaps = [convert(v) for v in list(system.b_exact)]
         # B = A Φ (m×N), G = Φᵀ W (N×m)
         self.B = [[sum((A[i][row] * self.shapes[k][row] for row in range(size)), domain.zero) for k in range(size)] for i in range(springs)]
         self.G = [[sum((self.shapes[k][row] * W[row][i] for row in range(size)), domain.zero) for i in range(springs)] for k in range(size)]
@@ -570,7 +571,7 @@ class NNMExpansion:
 
     def to_json(self, indent: int | None = 2) -> str:
         """JSON text of :meth:`to_dict`."""
-        return json.dumps(self.to_dict(), indent=indent)
+        return json.dumps(self.to_dict(), indent=indent, allow_nan=False)
 
     def to_latex(self) -> str:
         """A LaTeX fragment with λ_j, ω_1, ω_2 and the a_k."""
@@ -628,12 +629,11 @@ class StrainedCoordinatesNNM:
             raise ProblemError(f"mode must be an integer between 1 and {system.n_dof}, got {mode!r}")
         if isinstance(order, bool) or not isinstance(order, int) or not 0 <= order <= 12:
             raise ProblemError(f"order must be an integer between 0 and 12, got {order!r}")
-        amplitude = sympy.sympify(a0)
-        if not amplitude.is_number or not amplitude.is_real:
-            raise ProblemError(f"a0 must be a real number, got {a0!r}")
+        amplitude = parse_real(a0, what="a0")
+        correction = parse_real(a1, what="a1")
         if amplitude == 0:
             raise ProblemError("a0 = 0 is the rest state: give a nonzero modal amplitude a0")
-        hierarchy = _ModalHierarchy(system, mode - 1, amplitude, a1, self.precision + _guard_digits(system, mode - 1, order))
+        hierarchy = _ModalHierarchy(system, mode - 1, amplitude, correction, self.precision + _guard_digits(system, mode - 1, order))
         lam = hierarchy.frequencies[mode - 1]
         scale = 1 / (lam * lam)
         omegas = tuple(hierarchy.frequency(n) * lam * scale**n for n in range(order + 1))
@@ -652,7 +652,7 @@ class StrainedCoordinatesNNM:
             system=system,
             mode=mode,
             a0=float(amplitude),
-            a1=float(sympy.sympify(a1)),
+            a1=float(correction),
             order=order,
             lambdas=tuple(float(value) for value in hierarchy.frequencies),
             omega=omegas,

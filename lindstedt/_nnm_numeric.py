@@ -86,6 +86,7 @@ import numpy as np
 import scipy.optimize
 
 from ._errors import ConvergenceError, ProblemError
+from ._parsing import parse_float
 from ._flow import ExactFlow
 from ._system import UnilateralSystem
 
@@ -246,13 +247,7 @@ def _amplitude_spec(energy: Any, modal_amplitude: Any, energy_per_epsilon: Any) 
             f"(the seed's E = c ε); got {[name for name, _ in given] or 'none'}"
         )
     name, value = given[0]
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ProblemError(f"{name} must be a real number, got {value!r}") from None
-    if not math.isfinite(number):
-        raise ProblemError(f"{name} must be finite, got {number}")
-    return _Amplitude(name, number)
+    return _Amplitude(name, parse_float(value, what=name))
 
 
 def _check_mode(system: UnilateralSystem, mode: Any) -> int:
@@ -264,13 +259,7 @@ def _check_mode(system: UnilateralSystem, mode: Any) -> int:
 
 
 def _check_epsilon(epsilon: Any) -> float:
-    try:
-        value = float(epsilon)
-    except (TypeError, ValueError):
-        raise ProblemError(f"epsilon must be a real number, got {epsilon!r}") from None
-    if not math.isfinite(value):
-        raise ProblemError(f"epsilon must be finite, got {value}")
-    return value
+    return parse_float(epsilon, what="epsilon")
 
 
 # --------------------------------------------------------------------------- #

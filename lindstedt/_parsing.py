@@ -1,94 +1,296 @@
-"""Safe parsing of user input (nonlinearities f(u), numbers, parameter values).
+"""The one parser of user input: nonlinearities f(u), numbers and parameter values.
 
-Strings are tokenised first and every name is checked against a whitelist of
-mathematical functions, the variable ``u`` and the declared parameters, so no
-attribute access, dunder name or builtin can reach sympy's evaluator.  ``^`` is
-read as a power.  Decimals — a value ``"0.1"`` or a literal inside an
-expression, ``"Max(0, u - 0.3)"`` — are read *exactly* (as ``1/10``, ``3/10``).
+Every string that reaches lindstedt from a user (Python arguments, ``values=``,
+command-line flags, entries of a SYSTEM.json) is read here and nowhere else.
+Nothing is ever handed to ``eval``, ``sympify`` or ``parse_expr``: the text is
+parsed by Python's ``ast`` in expression mode and the tree is *walked* by a
+whitelist that builds the sympy expression node by node.
+
+Accepted grammar (``^`` is read as ``**``)::
+
+    expr    := expr ('+' | '-' | '*' | '/' | '**') expr | ('+' | '-') expr | '(' expr ')'
+             | NUMBER | NAME | FUNCTION '(' expr (',' expr)* ')'
+    NUMBER  := integer or decimal literal (``3``, ``0.25``, ``1e-3``, ``1_000``), read exactly
+    NAME    := 'u' | a declared parameter | 'pi' | 'E'
+    FUNCTION:= sin cos tan sinh cosh tanh asin acos atan exp log sqrt
+               Abs abs Max max Min min Heaviside sign
+
+Nothing else: no strings, bytes or f-strings, no attribute access, subscripts,
+keywords, lambdas, comprehensions, comparisons or assignment expressions.
+
+Bounds (checked *before* the work they protect is done; the error names the bound):
+:data:`LIMITS` — input length, number of syntax nodes, nesting depth, length of a
+numeric literal, size of a decimal exponent, integer exponents of powers and the
+size (in bits) of every exact number built along the way.
+
+Numbers are exact: ``"0.1"`` is 1/10, a Python ``float`` is its exact binary value
+(``0.1`` is 3602879701896397/36028797018963968), a sympy ``Float`` likewise.
 """
 
 from __future__ import annotations
 
-import io
-import keyword
+import ast
+import math
+import numbers
 import re
-import tokenize
-from typing import Any, Iterable, Mapping
+from dataclasses import dataclass
+from decimal import Decimal
+from fractions import Fraction
+from typing import Any, Callable, Mapping
 
 import sympy
-from sympy.parsing.sympy_parser import convert_xor, parse_expr, rationalize, standard_transformations
 
 from ._errors import ParameterError, ProblemError
 
-__all__ = ["ALLOWED_FUNCTIONS", "parse_expression", "parse_number", "parse_value"]
+__all__ = ["ALLOWED_FUNCTIONS", "CONSTANTS", "LIMITS", "ParserLimits", "as_exact", "parse_expression", "parse_float", "parse_real", "parse_value"]
 
-ALLOWED_FUNCTIONS: dict[str, Any] = {
-    "sin": sympy.sin,
-    "cos": sympy.cos,
-    "tan": sympy.tan,
-    "sinh": sympy.sinh,
-    "cosh": sympy.cosh,
-    "tanh": sympy.tanh,
-    "asin": sympy.asin,
-    "acos": sympy.acos,
-    "atan": sympy.atan,
-    "exp": sympy.exp,
-    "log": sympy.log,
-    "sqrt": sympy.sqrt,
-    "Abs": sympy.Abs,
-    "abs": sympy.Abs,
-    "Max": sympy.Max,
-    "max": sympy.Max,
-    "Min": sympy.Min,
-    "min": sympy.Min,
-    "Heaviside": sympy.Heaviside,
-    "sign": sympy.sign,
-    "pi": sympy.pi,
-    "E": sympy.E,
+
+@dataclass(frozen=True)
+class ParserLimits:
+    """Size bounds of the parser (every user string is checked against them).
+
+    Attributes
+    ----------
+    length : int
+        Characters of one input.
+    nodes : int
+        Syntax-tree nodes of one input.
+    depth : int
+        Nesting depth of the syntax tree.
+    literal : int
+        Characters of one numeric literal (the exact decimal of any double fits).
+    decimal_exponent : int
+        |e| of a literal ``…e±e``.
+    power : int
+        |p| and q of an exponent p/q of a power whose base is not a plain rational.
+    bits : int
+        Bits of numerator plus denominator of any exact rational built.
+    """
+
+    length: int = 2000
+    nodes: int = 500
+    depth: int = 40
+    literal: int = 1200
+    decimal_exponent: int = 400
+    power: int = 200
+    bits: int = 20000
+
+
+LIMITS = ParserLimits()
+
+# name -> (sympy callable, minimum and maximum number of arguments)
+ALLOWED_FUNCTIONS: dict[str, tuple[Callable[..., sympy.Expr], int, int]] = {
+    "sin": (sympy.sin, 1, 1),
+    "cos": (sympy.cos, 1, 1),
+    "tan": (sympy.tan, 1, 1),
+    "sinh": (sympy.sinh, 1, 1),
+    "cosh": (sympy.cosh, 1, 1),
+    "tanh": (sympy.tanh, 1, 1),
+    "asin": (sympy.asin, 1, 1),
+    "acos": (sympy.acos, 1, 1),
+    "atan": (sympy.atan, 1, 1),
+    "exp": (sympy.exp, 1, 1),
+    "log": (sympy.log, 1, 1),
+    "sqrt": (sympy.sqrt, 1, 1),
+    "Abs": (sympy.Abs, 1, 1),
+    "abs": (sympy.Abs, 1, 1),
+    "Max": (sympy.Max, 1, 16),
+    "max": (sympy.Max, 1, 16),
+    "Min": (sympy.Min, 1, 16),
+    "min": (sympy.Min, 1, 16),
+    "Heaviside": (sympy.Heaviside, 1, 1),
+    "sign": (sympy.sign, 1, 1),
 }
+CONSTANTS: dict[str, sympy.Expr] = {"pi": sympy.pi, "E": sympy.E}
 
-_PARSER_GLOBALS: dict[str, Any] = {
-    "__builtins__": {},
-    "Integer": sympy.Integer,
-    "Float": sympy.Float,
-    "Rational": sympy.Rational,
-    "Symbol": sympy.Symbol,
-    **ALLOWED_FUNCTIONS,
+_BINARY_OPERATORS: dict[type, Callable[[Any, Any], Any]] = {
+    ast.Add: lambda left, right: left + right,
+    ast.Sub: lambda left, right: left - right,
+    ast.Mult: lambda left, right: left * right,
+    ast.Div: lambda left, right: left / right,
 }
+_FORBIDDEN: dict[type, str] = {
+    ast.Attribute: "attribute access ('.')",
+    ast.Subscript: "subscripts ('[...]')",
+    ast.Lambda: "lambda",
+    ast.NamedExpr: "assignment expressions (':=')",
+    ast.JoinedStr: "f-strings",
+    ast.FormattedValue: "f-strings",
+    ast.Compare: "comparisons",
+    ast.BoolOp: "'and'/'or'",
+    ast.IfExp: "conditional expressions",
+    ast.ListComp: "comprehensions",
+    ast.SetComp: "comprehensions",
+    ast.DictComp: "comprehensions",
+    ast.GeneratorExp: "comprehensions",
+    ast.List: "lists",
+    ast.Tuple: "tuples",
+    ast.Set: "sets",
+    ast.Dict: "dictionaries",
+    ast.Starred: "'*' unpacking",
+    ast.Await: "await",
+    ast.Yield: "yield",
+    ast.YieldFrom: "yield",
+    ast.Slice: "slices",
+}
+# exp, sinh, cosh of a number are computed only for |x| <= 1000 (e^1000 ~ 1e434); any numeric function value must stay below 1e400
+_EXPONENTIAL = (sympy.exp, sympy.sinh, sympy.cosh)
+_EXPONENTIAL_ARGUMENT = 1000
+_LARGEST = sympy.Integer(10) ** 400
+_FLOAT_LITERAL = re.compile(r"^(?P<whole>[0-9_]*)(?:\.(?P<fraction>[0-9_]*))?(?:[eE](?P<exponent>[+-]?[0-9_]+))?$")
+_GRAMMAR_HINT = "use numbers, u, declared parameters, + - * / ** ^, parentheses and functions such as sin, exp, Max, Heaviside"
 
-_MAX_LENGTH = 2000
-_DECIMAL = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
+
+def _bits(number: sympy.Rational) -> int:
+    return int(number.p).bit_length() + int(number.q).bit_length()
 
 
-def _names_in(text: str) -> list[str]:
-    try:
-        tokens = list(tokenize.generate_tokens(io.StringIO(text).readline))
-    except (tokenize.TokenError, IndentationError, SyntaxError) as error:
-        raise ProblemError(f"cannot parse {text!r}: {error}; write it like 'u**3 + c*u**5'") from None
-    names = []
-    for token in tokens:
-        if token.type == tokenize.OP and token.string in {".", ";", "=", ":", "[", "]", "{", "}", "@", "lambda"}:
+def _check_size(value: Any, what: str, text: str) -> None:
+    if isinstance(value, sympy.Rational) and _bits(value) > LIMITS.bits:
+        raise ProblemError(
+            f"{what} = {text!r} builds a number of {_bits(value)} bits, more than the bound of {LIMITS.bits}; "
+            "write the quantity with smaller numbers"
+        )
+
+
+class _Builder:
+    """Walks a whitelisted syntax tree and builds the sympy expression bottom-up."""
+
+    def __init__(self, text: str, names: Mapping[str, sympy.Expr], what: str):
+        self.text = text
+        self.names = names
+        self.what = what
+
+    def fail(self, reason: str) -> ProblemError:
+        return ProblemError(f"cannot parse {self.what} = {self.text!r}: {reason}; {_GRAMMAR_HINT}")
+
+    def build(self, node: ast.AST, depth: int = 0) -> sympy.Expr:
+        if depth > LIMITS.depth:
+            raise ProblemError(f"{self.what} is nested more than {LIMITS.depth} levels deep; simplify it")
+        if isinstance(node, ast.Expression):
+            return self.build(node.body, depth)
+        if isinstance(node, ast.Constant):
+            return self.constant(node)
+        if isinstance(node, ast.Name):
+            return self.name(node.id)
+        if isinstance(node, ast.UnaryOp):
+            operand = self.build(node.operand, depth + 1)
+            if isinstance(node.op, ast.USub):
+                return -operand
+            if isinstance(node.op, ast.UAdd):
+                return operand
+            raise self.fail(f"the operator {type(node.op).__name__} is not allowed")
+        if isinstance(node, ast.BinOp):
+            left = self.build(node.left, depth + 1)
+            right = self.build(node.right, depth + 1)
+            if isinstance(node.op, ast.Pow):
+                result = self.power(left, right)
+            elif type(node.op) in _BINARY_OPERATORS:
+                result = _BINARY_OPERATORS[type(node.op)](left, right)
+            else:
+                raise self.fail(f"the operator {type(node.op).__name__} is not allowed")
+            _check_size(result, self.what, self.text)
+            return result
+        if isinstance(node, ast.Call):
+            return self.call(node, depth)
+        reason = _FORBIDDEN.get(type(node), f"the construct {type(node).__name__}")
+        raise self.fail(f"not allowed: {reason}")
+
+    def constant(self, node: ast.Constant) -> sympy.Expr:
+        value = node.value
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            kind = {str: "string literals", bytes: "bytes literals", complex: "complex numbers"}.get(type(value), repr(value))
+            raise self.fail(f"not allowed: {kind}")
+        literal = ast.get_source_segment(self.text, node) or ""
+        if len(literal) > LIMITS.literal:
+            raise ProblemError(f"{self.what}: a numeric literal longer than {LIMITS.literal} characters is not accepted")
+        if isinstance(value, int):
+            return sympy.Integer(value)
+        match = _FLOAT_LITERAL.match(literal)
+        if match is None:  # pragma: no cover - Python's tokenizer only makes such literals
+            raise self.fail(f"the literal {literal!r} is not a decimal number")
+        exponent = int((match["exponent"] or "0").replace("_", ""))
+        if abs(exponent) > LIMITS.decimal_exponent:
             raise ProblemError(
-                f"cannot parse {text!r}: the character {token.string!r} is not allowed; "
-                "use numbers, u, declared parameters, + - * / ** ^ and functions like sin, exp, Max"
+                f"{self.what}: the decimal exponent in {literal!r} exceeds the bound |e| <= {LIMITS.decimal_exponent}"
             )
-        if token.type == tokenize.NAME:
-            names.append(token.string)
-    return names
+        whole = (match["whole"] or "").replace("_", "")
+        fraction = (match["fraction"] or "").replace("_", "")
+        mantissa = int((whole + fraction) or "0")
+        return sympy.Rational(mantissa, 10 ** len(fraction)) * sympy.Rational(10) ** exponent
+
+    def name(self, identifier: str) -> sympy.Expr:
+        if identifier in self.names:
+            return self.names[identifier]
+        if identifier in CONSTANTS:
+            return CONSTANTS[identifier]
+        if identifier in ALLOWED_FUNCTIONS:
+            raise self.fail(f"the function {identifier!r} must be called, e.g. {identifier}(u)")
+        if identifier.startswith("_"):
+            raise self.fail(f"the name {identifier!r} is not allowed")
+        raise ParameterError(
+            f"{self.what} uses {identifier!r}, which is neither the variable nor a declared parameter; "
+            f"declare it, e.g. params={{{identifier!r}: value}} in Python or --param {identifier}=VALUE on the command line"
+        )
+
+    def power(self, base: sympy.Expr, exponent: sympy.Expr) -> sympy.Expr:
+        if isinstance(exponent, sympy.Rational):
+            p, q = abs(int(exponent.p)), int(exponent.q)
+            if isinstance(base, sympy.Rational):
+                if base not in (0, 1, -1) and (q > LIMITS.power or _bits(base) * p > LIMITS.bits * q):
+                    raise ProblemError(
+                        f"{self.what} = {self.text!r}: the power {base}**({exponent}) exceeds the bound of "
+                        f"{LIMITS.bits} bits; write the quantity with smaller numbers"
+                    )
+            elif p > LIMITS.power or q > LIMITS.power:
+                raise ProblemError(
+                    f"{self.what} = {self.text!r}: exponents are bounded by {LIMITS.power} in numerator and denominator, "
+                    f"got {exponent}"
+                )
+        elif exponent.is_number and isinstance(base, sympy.Rational):
+            # irrational numeric exponent: sympy keeps 2**pi symbolic, but a huge one would be evaluated later
+            if exponent.has(sympy.zoo, sympy.nan, sympy.oo, -sympy.oo) or abs(sympy.N(exponent, 15)) > LIMITS.power:
+                raise ProblemError(f"{self.what} = {self.text!r}: the exponent {exponent} exceeds the bound {LIMITS.power}")
+        return base**exponent
+
+    def call(self, node: ast.Call, depth: int) -> sympy.Expr:
+        if not isinstance(node.func, ast.Name) or node.func.id not in ALLOWED_FUNCTIONS:
+            callee = node.func.id if isinstance(node.func, ast.Name) else type(node.func).__name__
+            raise self.fail(f"calling {callee!r} is not allowed (allowed functions: {', '.join(sorted(ALLOWED_FUNCTIONS))})")
+        if node.keywords:
+            raise self.fail("keyword arguments are not allowed")
+        function, least, most = ALLOWED_FUNCTIONS[node.func.id]
+        if not least <= len(node.args) <= most:
+            raise self.fail(f"{node.func.id} takes {least if least == most else f'{least} to {most}'} argument(s)")
+        arguments = [self.build(argument, depth + 1) for argument in node.args]
+        if function in _EXPONENTIAL and arguments[0].is_number and not abs(sympy.N(arguments[0], 15)) <= _EXPONENTIAL_ARGUMENT:
+            raise ProblemError(
+                f"{self.what} = {self.text!r}: {node.func.id} of a number larger than {_EXPONENTIAL_ARGUMENT} in magnitude is not accepted"
+            )
+        try:
+            result = function(*arguments)
+        except (TypeError, ValueError, ArithmeticError) as error:
+            raise self.fail(f"{node.func.id}{tuple(arguments)} cannot be formed ({error})") from None
+        if result.is_number and not isinstance(result, sympy.Rational):
+            magnitude = abs(sympy.N(result, 15))
+            if magnitude.has(sympy.nan, sympy.zoo, sympy.oo) or magnitude > _LARGEST:
+                raise ProblemError(f"{self.what} = {self.text!r}: {node.func.id}{tuple(arguments)} is not a finite number of moderate size")
+        return result
 
 
 def parse_expression(
     text: str | sympy.Expr | int | float,
     *,
-    symbols: Mapping[str, sympy.Symbol],
+    symbols: Mapping[str, sympy.Expr],
     what: str = "f",
 ) -> sympy.Expr:
-    """Parse ``text`` into a sympy expression using only whitelisted names.
+    """Read ``text`` into a sympy expression through the whitelist (the only way user text becomes sympy).
 
     Parameters
     ----------
     text : str or sympy expression or number
-        The expression.  Strings are tokenised and checked before parsing.
+        The expression.  Strings follow the grammar of this module; sympy
+        objects are the caller's own (their ``Float`` atoms become exact).
     symbols : mapping
         Names that may appear (the variable ``u`` and declared parameters).
     what : str
@@ -97,11 +299,12 @@ def parse_expression(
     Returns
     -------
     sympy.Expr
+        Finite: an expression containing ``nan``, ``oo`` or ``zoo`` is refused.
 
     Raises
     ------
     ProblemError
-        If the text cannot be parsed or uses a forbidden construct.
+        If the text is not in the grammar or exceeds a bound of :data:`LIMITS`.
     ParameterError
         If it uses a name that is neither allowed nor declared.
 
@@ -109,93 +312,168 @@ def parse_expression(
     --------
     >>> import sympy
     >>> u, c = sympy.symbols("u c")
-    >>> parse_expression("u^3 + c*u**5", symbols={"u": u, "c": c})
-    c*u**5 + u**3
+    >>> parse_expression("u^3 + c*u**5 + 0.5", symbols={"u": u, "c": c})
+    c*u**5 + u**3 + 1/2
+    >>> try:
+    ...     parse_expression("sin('x')", symbols={"u": u})
+    ... except ProblemError as error:
+    ...     print(str(error).split(";")[0])
+    cannot parse f = "sin('x')": not allowed: string literals
     """
-    if isinstance(text, sympy.Basic):
-        return sympy.sympify(text)
-    if isinstance(text, (int, float)) and not isinstance(text, bool):
-        return sympy.sympify(text)
     if not isinstance(text, str):
-        raise ProblemError(f"{what} must be a string or a sympy expression, got {type(text).__name__}")
-    if len(text) > _MAX_LENGTH:
-        raise ProblemError(f"{what} is longer than {_MAX_LENGTH} characters; simplify it before passing it")
-    if not text.strip():
-        raise ProblemError(f"{what} is empty; give an expression such as 'u**3'")
-    for name in _names_in(text):
-        if "__" in name or keyword.iskeyword(name):
-            raise ProblemError(f"{what}: the name {name!r} is not allowed in an expression")
-        if name not in symbols and name not in ALLOWED_FUNCTIONS:
-            raise ParameterError(
-                f"{what} uses {name!r}, which is neither the variable nor a declared parameter; "
-                f"declare it, e.g. params={{{name!r}: value}} in Python or --param {name}=VALUE on the command line"
-            )
-    local_names = dict(symbols)
-    try:
-        expression = parse_expr(
-            text,
-            local_dict=local_names,
-            global_dict=dict(_PARSER_GLOBALS),
-            transformations=standard_transformations + (convert_xor, rationalize),
-            evaluate=True,
-        )
-    except (SyntaxError, TypeError, ValueError, AttributeError, ZeroDivisionError, tokenize.TokenError) as error:
-        raise ProblemError(f"cannot parse {what} = {text!r}: {error}") from None
+        if isinstance(text, bool) or not isinstance(text, (sympy.Basic, numbers.Number, Decimal)):
+            raise ProblemError(f"{what} must be a string or a sympy expression, got {type(text).__name__}")
+        expression = as_exact(text, what=what)
+    else:
+        expression = _parse_text(text, symbols, what)
     if not isinstance(expression, sympy.Expr):
         raise ProblemError(f"{what} = {text!r} is not a mathematical expression")
+    if expression.has(sympy.zoo, sympy.oo, -sympy.oo, sympy.nan):
+        raise ProblemError(f"{what} = {text!r} is not finite (it contains a division by zero, an infinity or NaN)")
     return expression
 
 
-def parse_number(text: str | int | float | sympy.Expr, *, what: str) -> sympy.Expr:
-    """Parse a numeric value; decimal strings become exact rationals.
+def _parse_text(text: str, symbols: Mapping[str, sympy.Expr], what: str) -> sympy.Expr:
+    if len(text) > LIMITS.length:
+        raise ProblemError(f"{what} is longer than {LIMITS.length} characters; simplify it before passing it")
+    if not text.strip():
+        raise ProblemError(f"{what} is empty; give an expression such as 'u**3'")
+    source = text.strip().replace("^", "**")
+    try:
+        tree = ast.parse(source, mode="eval")
+    except (SyntaxError, ValueError, RecursionError, MemoryError) as error:
+        reason = getattr(error, "msg", None) or type(error).__name__
+        raise ProblemError(f"cannot parse {what} = {text!r}: {reason}; {_GRAMMAR_HINT}") from None
+    count = sum(1 for _ in ast.walk(tree))
+    if count > LIMITS.nodes:
+        raise ProblemError(f"{what} has {count} syntax nodes, more than the bound of {LIMITS.nodes}; simplify it")
+    try:
+        return _Builder(source, symbols, what).build(tree)
+    except RecursionError:  # pragma: no cover - the depth bound comes first
+        raise ProblemError(f"{what} is nested too deeply; simplify it") from None
+
+
+def as_exact(value: Any, *, what: str) -> sympy.Expr:
+    """Convert a Python or sympy number/expression to an exact sympy object (strings are refused).
+
+    ``float`` and sympy ``Float`` become their exact binary value, ``Fraction``
+    and ``Decimal`` their exact value; integers are bounded like literals.
 
     Examples
     --------
-    >>> parse_number("0.1", what="a0")
-    1/10
-    >>> parse_number("1/3", what="a0")
-    1/3
+    >>> as_exact(0.5, what="a0"), as_exact(0.1, what="b")
+    (1/2, 3602879701896397/36028797018963968)
     """
-    if isinstance(text, str):
-        stripped = text.strip()
-        if _DECIMAL.match(stripped):
-            return sympy.Rational(stripped)
-        value = parse_expression(stripped, symbols={}, what=what)
-    elif isinstance(text, bool):
-        raise ProblemError(f"{what} must be a number, got a boolean")
+    if isinstance(value, str):
+        raise ProblemError(f"{what}: strings must go through parse_real or parse_expression")  # internal misuse
+    if isinstance(value, bool):
+        raise ProblemError(f"{what} must be a number, got the boolean {value}")
+    if isinstance(value, numbers.Integral):
+        number = sympy.Integer(int(value))
+    elif isinstance(value, (float, Decimal)) or (isinstance(value, numbers.Real) and not isinstance(value, sympy.Basic)):
+        if isinstance(value, numbers.Rational):
+            number = sympy.Rational(int(value.numerator), int(value.denominator))
+        else:
+            floating = value if isinstance(value, Decimal) else float(value)
+            finite = floating.is_finite() if isinstance(floating, Decimal) else math.isfinite(floating)
+            if not finite:
+                raise ProblemError(f"{what} = {value!r} is not finite; give a finite real number")
+            exact = Fraction(floating)
+            number = sympy.Rational(exact.numerator, exact.denominator)
+    elif isinstance(value, numbers.Complex) and not isinstance(value, sympy.Basic):
+        raise ProblemError(f"{what} = {value!r} is complex; give a real number")
+    elif isinstance(value, sympy.Basic):
+        number = value
+        floats = number.atoms(sympy.Float)
+        if floats:
+            if any(not math.isfinite(float(f)) for f in floats):
+                raise ProblemError(f"{what} = {value} is not finite; give a finite real number")
+            number = number.xreplace({f: sympy.Rational(f) for f in floats})
     else:
-        value = sympy.sympify(text)
-    if value.free_symbols:
-        raise ProblemError(f"{what} = {text!r} must be a number here")
-    return value
+        raise ProblemError(
+            f"{what} has type {type(value).__name__}; give an int, float, Fraction, an exact string such as '1/3', or a sympy number"
+        )
+    _check_size(number, what, str(value)[:60])
+    return number
 
 
-def parse_value(
-    text: str | int | float | sympy.Expr | None,
-    *,
-    name: str,
-    symbol: sympy.Symbol,
-    allowed: Iterable[str] = (),
-) -> sympy.Expr:
-    """Parse a parameter-like value: ``None`` or its own name means "keep symbolic".
+def parse_real(value: Any, *, what: str) -> sympy.Expr:
+    """A finite real number, exactly: where the API needs a number, this reads it.
+
+    Accepts int, float (exact binary value), Fraction, Decimal, numpy scalars,
+    sympy numbers and strings in the grammar of this module without names other
+    than ``pi`` and ``E`` (``"1/3"``, ``"0.25"``, ``"sqrt(2)/2"``).  NaN, inf,
+    complex values, words and symbols are refused.
+
+    Raises
+    ------
+    ProblemError
+        Naming the quantity and what to give instead.
+
+    Examples
+    --------
+    >>> parse_real("0.1", what="a0"), parse_real("1/3", what="a0"), parse_real(0.25, what="a0")
+    (1/10, 1/3, 1/4)
+    >>> parse_real("nan", what="a0")
+    Traceback (most recent call last):
+    ...
+    lindstedt._errors.ProblemError: a0 must be a finite real number such as 1, 0.5, '1/3' or 'sqrt(2)', got 'nan'
+    """
+    if isinstance(value, str):
+        try:
+            number = parse_expression(value, symbols={}, what=what)
+        except ParameterError:
+            raise ProblemError(f"{what} must be a finite real number such as 1, 0.5, '1/3' or 'sqrt(2)', got {value!r}") from None
+    else:
+        number = as_exact(value, what=what)
+    if not isinstance(number, sympy.Expr) or number.free_symbols or not number.is_number:
+        raise ProblemError(f"{what} must be a finite real number such as 1, 0.5, '1/3' or 'sqrt(2)', got {value!r}")
+    if number.has(sympy.zoo, sympy.oo, -sympy.oo, sympy.nan) or number.is_finite is False:
+        raise ProblemError(f"{what} = {value!r} is not finite; give a finite real number")
+    if number.is_real is not True:
+        approximation = complex(sympy.N(number, 30))
+        if number.is_real is False or approximation.imag != 0 or not math.isfinite(approximation.real):
+            raise ProblemError(f"{what} = {value!r} is not a real number; give a finite real number")
+    return number
+
+
+def parse_value(value: Any, *, name: str, symbol: sympy.Symbol) -> sympy.Expr:
+    """A parameter's value: ``None``, its own name or a sympy Symbol keep it symbolic; anything else is a number.
 
     Examples
     --------
     >>> import sympy
     >>> c = sympy.Symbol("c", real=True)
-    >>> parse_value(None, name="c", symbol=c)
-    c
-    >>> parse_value("2/7", name="c", symbol=c)
-    2/7
+    >>> parse_value(None, name="c", symbol=c), parse_value("2/7", name="c", symbol=c)
+    (c, 2/7)
     """
-    if text is None:
+    if value is None:
         return symbol
-    if isinstance(text, sympy.Symbol):
-        return text
-    if isinstance(text, str) and text.strip() == name:
-        return symbol
-    if isinstance(text, str) and not _DECIMAL.match(text.strip()):
-        known = {other: sympy.Symbol(other, real=True) for other in allowed}
-        value = parse_expression(text, symbols=known, what=name)
+    if isinstance(value, sympy.Symbol):
         return value
-    return parse_number(text, what=name)
+    if isinstance(value, str) and value.strip() == name:
+        return symbol
+    return parse_real(value, what=name)
+
+
+def parse_float(value: Any, *, what: str) -> float:
+    """A finite real number as a float (the correctly rounded value of :func:`parse_real`).
+
+    Examples
+    --------
+    >>> parse_float("1/3", what="epsilon"), parse_float(0.25, what="epsilon")
+    (0.3333333333333333, 0.25)
+    """
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        number = float(value)
+        if not math.isfinite(number):
+            raise ProblemError(f"{what} = {value!r} is not finite; give a finite real number")
+        return number
+    exact = parse_real(value, what=what)
+    number = float(exact) if isinstance(exact, sympy.Rational) else float(sympy.N(exact, 20))
+    if not math.isfinite(number):
+        raise ProblemError(f"{what} = {value!r} does not fit in a double; give a smaller number")
+    return number
+
+
+parse_number = parse_real  # transitional alias, removed once every caller is updated

@@ -15,19 +15,23 @@ normalisation is explicit:
 
 from __future__ import annotations
 
+import keyword
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 import sympy
 
 from ._errors import ParameterError, ProblemError
-from ._parsing import parse_expression, parse_number, parse_value
+from ._parsing import ALLOWED_FUNCTIONS, CONSTANTS, as_exact, parse_expression, parse_real, parse_value
 
 __all__ = ["Oscillator", "NORMALIZATIONS", "DISPLACEMENT"]
 
 NORMALIZATIONS = ("initial", "harmonic")
 DISPLACEMENT = sympy.Symbol("u", real=True)
 _NON_SMOOTH = (sympy.Max, sympy.Min, sympy.Heaviside, sympy.Abs, sympy.sign, sympy.Piecewise)
+# Names a parameter cannot take: the variables of the problem and of its results (u, the strained time s,
+# the time t, epsilon, a0, omega0, the normalised w) and the names the parser reserves for functions and constants.
+RESERVED_NAMES = frozenset({"u", "s", "t", "w", "epsilon", "a0", "omega0"}) | frozenset(ALLOWED_FUNCTIONS) | frozenset(CONSTANTS)
 
 
 def _default_amplitude() -> sympy.Symbol:
@@ -38,15 +42,16 @@ def _default_omega0() -> sympy.Symbol:
     return sympy.Symbol("omega0", positive=True)
 
 
-def _symbol_from_text(text: str) -> sympy.Expr | None:
-    """``"name"`` -> positive symbol, ``"-name"`` -> its negative; otherwise None."""
-    stripped = text.strip()
-    negative = stripped.startswith("-")
-    name = stripped[1:].strip() if negative else stripped
-    if name.isidentifier():
-        symbol = sympy.Symbol(name, positive=True)
-        return -symbol if negative else symbol
-    return None
+def _given_quantity(value: Any, what: str) -> sympy.Expr:
+    """a0 or omega0 as given: a number (exact), or a sympy expression in symbols the caller made."""
+    if isinstance(value, sympy.Basic) and not value.is_number:
+        expression = as_exact(value, what=what)
+        if not isinstance(expression, sympy.Expr) or expression.has(sympy.zoo, sympy.oo, -sympy.oo, sympy.nan):
+            raise ProblemError(f"{what} = {value} must be a finite real expression")
+        if any(symbol.is_real is not True for symbol in expression.free_symbols):
+            raise ProblemError(f"{what} = {value}: declare its symbols real, e.g. sympy.Symbol('{what}', positive=True)")
+        return expression
+    return parse_real(value, what=what)
 
 
 @dataclass(frozen=True)
@@ -58,13 +63,18 @@ class Oscillator:
     f : str or sympy expression
         The nonlinearity, in the variable ``u``.  Strings are parsed safely
         (``^`` means power; decimals are exact).
-    a0 : number, str or sympy expression, optional
+    a0 : number, numeric string or sympy expression, optional
         Amplitude (see ``normalization``).  Default: the positive symbol ``a0``.
-    omega0 : number, str or sympy expression, optional
+        Numbers are exact: a float means its binary value, ``"0.1"`` means 1/10
+        (strings are read by the one parser, ``lindstedt._parsing``); a sympy
+        expression may contain real symbols of the caller's own.
+    omega0 : number, numeric string or sympy expression, optional
         Linear angular frequency, must be positive.  Default: the positive symbol ``omega0``.
     params : mapping name -> value, optional
         Every symbol of f other than ``u`` must be declared here.  A value of
-        ``None`` (or the parameter's own name) keeps it symbolic.
+        ``None`` (or the parameter's own name, or a sympy Symbol) keeps it symbolic;
+        any other value must be a finite real number.  Reserved names
+        (:data:`RESERVED_NAMES`) cannot be parameters.
     normalization : {"initial", "harmonic"}
         Meaning of ``a0``: release point, or first-harmonic amplitude.
 
@@ -103,16 +113,17 @@ class Oscillator:
             raise ParameterError("params must be a mapping {name: value}, e.g. {'c': '1/3'}")
         parameter_symbols: dict[str, sympy.Symbol] = {}
         for name in raw_params:
-            if not isinstance(name, str) or not name.isidentifier() or name.startswith("_"):
+            if not isinstance(name, str) or not name.isidentifier() or name.startswith("_") or keyword.iskeyword(name):
                 raise ParameterError(f"parameter name {name!r} must be a plain identifier such as 'c'")
-            if name == "u":
-                raise ParameterError("'u' is the displacement variable and cannot be a parameter; rename it")
+            if name in RESERVED_NAMES:
+                role = "the displacement variable" if name == "u" else "a reserved name (variables s, t, w, epsilon, a0, omega0 of the results, functions and constants of the grammar)"
+                raise ParameterError(f"{name!r} is {role} and cannot be a parameter; rename it, e.g. 'c'")
             parameter_symbols[name] = sympy.Symbol(name, real=True)
         values: dict[str, sympy.Expr] = {}
         for name, value in raw_params.items():
             if isinstance(value, sympy.Symbol) and value.name == name:
                 parameter_symbols[name] = value
-            values[name] = parse_value(value, name=name, symbol=parameter_symbols[name], allowed=())
+            values[name] = parse_value(value, name=name, symbol=parameter_symbols[name])
             if values[name].free_symbols - {parameter_symbols[name]}:
                 raise ParameterError(
                     f"the value of parameter {name!r} must be a number (or None to keep it symbolic), got {value!r}"
@@ -154,19 +165,8 @@ class Oscillator:
     def _parse_amplitude(value: Any) -> sympy.Expr:
         if value is None:
             return _default_amplitude()
-        if isinstance(value, str):
-            symbol = _symbol_from_text(value)
-            amplitude = symbol if symbol is not None else parse_number(value, what="a0")
-        else:
-            amplitude = sympy.sympify(value)
-        if amplitude.is_number:
-            if amplitude.is_real is False or amplitude.has(sympy.I):
-                raise ProblemError(f"a0 must be real, got {amplitude}")
-            if amplitude.is_finite is False:
-                raise ProblemError(f"a0 must be finite, got {amplitude}")
-            if amplitude == 0:
-                raise ProblemError("a0 = 0 is the rest state: give a nonzero amplitude a0")
-        elif amplitude.is_zero:
+        amplitude = _given_quantity(value, "a0")
+        if amplitude.is_number and amplitude == 0 or amplitude.is_zero:
             raise ProblemError("a0 = 0 is the rest state: give a nonzero amplitude a0")
         return amplitude
 
@@ -174,16 +174,8 @@ class Oscillator:
     def _parse_omega0(value: Any) -> sympy.Expr:
         if value is None:
             return _default_omega0()
-        if isinstance(value, str):
-            symbol = _symbol_from_text(value)
-            if symbol is not None and symbol.is_negative:
-                raise ProblemError(f"omega0 must be positive, got {value!r}")
-            omega0 = symbol if symbol is not None else parse_number(value, what="omega0")
-        else:
-            omega0 = sympy.sympify(value)
+        omega0 = _given_quantity(value, "omega0")
         if omega0.is_number:
-            if omega0.has(sympy.I) or omega0.is_real is False or omega0.is_finite is False:
-                raise ProblemError(f"omega0 must be a positive real number, got {omega0}")
             if not omega0 > 0:
                 raise ProblemError(f"omega0 must be positive (it is the linear angular frequency), got {omega0}")
         elif omega0.is_positive is not True:
@@ -236,7 +228,7 @@ class Oscillator:
         given: dict[str, sympy.Expr] = {}
         for key, value in (values or {}).items():
             name = key.name if isinstance(key, sympy.Symbol) else str(key)
-            given[name] = parse_number(value, what=name) if isinstance(value, str) else sympy.sympify(value)
+            given[name] = parse_real(value, what=name)
         substitution: dict[sympy.Symbol, sympy.Expr] = {}
         missing = []
         for symbol in sorted(self.free_symbols, key=str):

@@ -67,7 +67,7 @@ _SIN = "sin"
 
 def _canonical(expr: Scalar) -> sympy.Expr:
     """Canonical exact form: trig of integer multiples expanded, then fully expanded."""
-    value = sympy.sympify(expr)
+    value = sympy.sympify(expr, strict=True)
     if value.has(sympy.sin, sympy.cos):
         value = sympy.expand_trig(value)
     return sympy.expand(value)
@@ -110,7 +110,7 @@ def _same_point(left: sympy.Expr, right: sympy.Expr) -> bool | None:
 
 def _as_scalar(value: Scalar, name: str) -> sympy.Expr:
     try:
-        expr = sympy.sympify(value)
+        expr = sympy.sympify(value, strict=True)
     except (sympy.SympifyError, TypeError) as exc:
         raise ProblemError(f"{name}={value!r} is not a number or sympy expression") from exc
     if not isinstance(expr, sympy.Expr):
@@ -119,7 +119,7 @@ def _as_scalar(value: Scalar, name: str) -> sympy.Expr:
 
 
 def _as_frequency(frequency: Scalar) -> sympy.Expr:
-    value = sympy.sympify(frequency)
+    value = sympy.sympify(frequency, strict=True)
     if value.is_number and not value.is_Integer:
         raise ProblemError(f"frequency {frequency!r} is not an integer; quasi-trig terms use cos(j s), sin(j s) with integer j")
     return value
@@ -149,7 +149,7 @@ def _normalize_key(power: int, kind: str, frequency: sympy.Expr, coefficient: sy
 
 
 def _accumulate(target: dict, key: TermKey, coefficient: sympy.Expr) -> None:
-    normalized = _normalize_key(key[0], key[1], sympy.sympify(key[2]), sympy.sympify(coefficient))
+    normalized = _normalize_key(key[0], key[1], sympy.sympify(key[2], strict=True), sympy.sympify(coefficient, strict=True))
     if normalized is None:
         return
     normalized_key, value = normalized
@@ -263,7 +263,7 @@ class QuasiTrigPolynomial:
         cos(2*s)/2 + 1/2
         """
         total = cls()
-        for term in sympy.Add.make_args(sympy.expand(sympy.sympify(expr))):
+        for term in sympy.Add.make_args(sympy.expand(sympy.sympify(expr, strict=True))):
             product = cls.constant(1)
             coefficient = sympy.Integer(1)
             for factor in sympy.Mul.make_args(term):
@@ -518,7 +518,7 @@ class QuasiTrigPolynomial:
         """
         accumulated: dict = {}
         for (power, kind, frequency), coefficient in self.terms:
-            _accumulate(accumulated, (power, kind, sympy.sympify(frequency).subs(substitutions)),
+            _accumulate(accumulated, (power, kind, sympy.sympify(frequency, strict=True).subs(substitutions)),
                         coefficient.subs(substitutions))
         return QuasiTrigPolynomial._from_accumulated(accumulated)
 
@@ -692,7 +692,7 @@ class PiecewiseQuasiTrig:
     pieces: tuple[QuasiTrigPolynomial, ...]
 
     def __post_init__(self) -> None:
-        breakpoints = tuple(sympy.sympify(point) for point in self.breakpoints)
+        breakpoints = tuple(sympy.sympify(point, strict=True) for point in self.breakpoints)
         object.__setattr__(self, "breakpoints", breakpoints)
         object.__setattr__(self, "pieces", tuple(self.pieces))
         if len(self.pieces) < 1 or len(breakpoints) != len(self.pieces) + 1:
@@ -742,7 +742,7 @@ class PiecewiseQuasiTrig:
         1
         """
         pieces = tuple(QuasiTrigPolynomial.from_expr(expr, variable) for expr in expressions)
-        points = (sympy.Integer(0),) + tuple(sympy.sympify(point) for point in interior_breakpoints) + (sympy.pi,)
+        points = (sympy.Integer(0),) + tuple(sympy.sympify(point, strict=True) for point in interior_breakpoints) + (sympy.pi,)
         return cls(points, pieces)
 
     @classmethod
@@ -788,7 +788,7 @@ class PiecewiseQuasiTrig:
         """
         merged = self.breakpoints
         for point in breakpoints:
-            merged = _merge_breakpoints(merged, (sympy.Integer(0), sympy.sympify(point), sympy.pi))
+            merged = _merge_breakpoints(merged, (sympy.Integer(0), sympy.sympify(point, strict=True), sympy.pi))
         return self._on(merged)
 
     def _on(self, merged: tuple[sympy.Expr, ...]) -> "PiecewiseQuasiTrig":
@@ -868,7 +868,7 @@ class PiecewiseQuasiTrig:
         >>> contact_ramp_function(kappa).substitute({kappa: sympy.Rational(1, 2)}).breakpoints
         (0, pi/3, pi)
         """
-        points = tuple(sympy.sympify(point).subs(substitutions) for point in self.breakpoints)
+        points = tuple(sympy.sympify(point, strict=True).subs(substitutions) for point in self.breakpoints)
         return PiecewiseQuasiTrig(points, tuple(piece.substitute(substitutions) for piece in self.pieces))
 
     def map_coefficients(self, function: Callable[[sympy.Expr], sympy.Expr]) -> "PiecewiseQuasiTrig":
@@ -948,7 +948,7 @@ class PiecewiseQuasiTrig:
         >>> PiecewiseQuasiTrig.from_expression(S).cosine_coefficient(k)
         2*(-1)**k/(pi*k**2) - 2/(pi*k**2)
         """
-        harmonic = sympy.sympify(k)
+        harmonic = sympy.sympify(k, strict=True)
         if harmonic.is_number:
             if not harmonic.is_Integer or harmonic < 0:
                 raise ProblemError(f"harmonic k={k!r} must be a non-negative integer")
@@ -1017,7 +1017,7 @@ class PiecewiseQuasiTrig:
 
     def breakpoints_float(self, substitutions: Mapping | None = None) -> np.ndarray:
         """Breakpoints as floats (free symbols substituted)."""
-        return np.array([_float_value(sympy.sympify(point), substitutions, "breakpoint") for point in self.breakpoints])
+        return np.array([_float_value(sympy.sympify(point, strict=True), substitutions, "breakpoint") for point in self.breakpoints])
 
     def evaluate_float(self, points: object, substitutions: Mapping | None = None) -> np.ndarray:
         """Vectorised float evaluation at any real points (even 2*pi-periodic extension).

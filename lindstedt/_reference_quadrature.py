@@ -40,6 +40,7 @@ import mpmath
 import sympy
 
 from ._errors import ConvergenceError, OrderError, ParameterError, ProblemError
+from ._parsing import parse_real
 
 __all__ = [
     "conservative_period",
@@ -62,7 +63,7 @@ def as_mpmath_number(value: Any, name: str = "value") -> mpmath.mpf | mpmath.mpc
 
     Accepts ``int``, ``float``, ``complex``, :class:`fractions.Fraction`,
     sympy numbers (``Rational``, ``Float``, ``pi``, ``sqrt(2)``, complex
-    constants), decimal strings (``"0.7"``) and mpmath numbers.  Exact inputs
+    constants), numeric strings (``"0.7"``, ``"1/3"``, read by the one parser) and mpmath numbers.  Exact inputs
     are rounded once, at the precision in effect.
 
     Examples
@@ -76,6 +77,8 @@ def as_mpmath_number(value: Any, name: str = "value") -> mpmath.mpf | mpmath.mpc
         raise ProblemError(f"{name} must be a number, got the bool {value!r}")
     if isinstance(value, (mpmath.mpf, mpmath.mpc)):
         return value
+    if isinstance(value, str):  # user text: read by the one parser, exactly
+        value = parse_real(value, what=name)
     if isinstance(value, Fraction):
         return mpmath.mpf(value.numerator) / value.denominator
     if isinstance(value, sympy.Basic):
@@ -92,7 +95,7 @@ def as_mpmath_number(value: Any, name: str = "value") -> mpmath.mpf | mpmath.mpc
         if imaginary_part == 0:
             return real_value
         return mpmath.mpc(real_value, mpmath.mpf(str(sympy.Float(imaginary_part, mpmath.mp.dps + 10))))
-    if isinstance(value, (str, Number)):
+    if isinstance(value, Number):
         try:
             return mpmath.mpmathify(value)
         except (TypeError, ValueError) as error:
@@ -126,8 +129,8 @@ def validate_dps(dps: Any) -> int:
     >>> validate_dps(30)
     30
     """
-    if isinstance(dps, bool) or not isinstance(dps, int) or dps < 5:
-        raise ProblemError(f"dps (decimal digits of precision) must be an int >= 5, got {dps!r}")
+    if isinstance(dps, bool) or not isinstance(dps, int) or not 5 <= dps <= 5000:
+        raise ProblemError(f"dps (decimal digits of precision) must be an int between 5 and 5000, got {dps!r}")
     return dps
 
 
@@ -136,7 +139,7 @@ class _Potential:
 
     def __init__(self, nonlinearity: Nonlinearity) -> None:
         if isinstance(nonlinearity, sympy.Basic):
-            expression = sympy.sympify(nonlinearity)
+            expression = nonlinearity
             free = expression.free_symbols
             variables = [symbol for symbol in free if symbol.name == "u"]
             others = sorted(symbol.name for symbol in free if symbol.name != "u")

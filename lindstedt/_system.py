@@ -13,16 +13,14 @@
   ``E = ½ X'ᵀ M X' + ½ Xᵀ K X + ½ ε Σ_i (A_i X − b_i)_+²``.
 
 ``(·)_+ = max(·, 0)`` acts entrywise.  Every matrix is stored twice: exactly
-(``sympy.ImmutableMatrix``; decimal input such as ``0.1`` or ``"0.1"`` is read
-as ``1/10``) and as a read-only float ``numpy`` array (the correctly rounded
+(``sympy.ImmutableMatrix``; the string ``"0.1"`` is read as ``1/10``, the float
+``0.1`` as its exact binary value) and as a read-only float ``numpy`` array (the correctly rounded
 values of the exact entries).  The N-dof setting is section 4 of the seed
 paper, whose force term ``ε (Ã X − B)_+`` is the special case ``W = I``.
 """
 
 from __future__ import annotations
 
-import math
-import numbers
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
@@ -33,7 +31,7 @@ import scipy.linalg
 import sympy
 
 from ._errors import ProblemError
-from ._parsing import parse_number
+from ._parsing import parse_real
 
 __all__ = ["UnilateralSystem", "Modes", "OneDofUnilateral"]
 
@@ -63,52 +61,12 @@ class Modes(NamedTuple):
 # exact conversion of user input
 # --------------------------------------------------------------------------- #
 def _exact_scalar(value: Any, what: str) -> sympy.Expr:
-    """Convert one entry to an exact, finite, real sympy number."""
-    if isinstance(value, (bool, np.bool_)):
+    """One entry as an exact, finite, real sympy number (read by the one parser; a float is its binary value)."""
+    if isinstance(value, np.bool_):
         raise ProblemError(f"{what} is a boolean ({value}); give a number such as 1, 0.5 or '1/3'")
-    if isinstance(value, (int, np.integer)):
-        return sympy.Integer(int(value))
-    if isinstance(value, (float, np.floating)):
-        number = float(value)
-        if not math.isfinite(number):
-            raise ProblemError(f"{what} is {number}; every entry must be a finite real number")
-        # repr() is the shortest decimal that rounds to this float: 0.1 -> 1/10.
-        return sympy.Rational(repr(number))
-    if isinstance(value, Fraction):
-        return sympy.Rational(value.numerator, value.denominator)
-    if isinstance(value, str):
-        if value.strip().lower().lstrip("+-") in {"nan", "inf", "infinity", "oo", "zoo"}:
-            raise ProblemError(f"{what} is {value!r}; every entry must be a finite real number")
-        try:
-            expr = parse_number(value, what=what)
-        except ProblemError as error:
-            raise ProblemError(
-                f"{what} = {value!r} is not an exact number ({error}); write it like '1/3', '0.25' or 'sqrt(2)'"
-            ) from None
-    elif isinstance(value, sympy.Basic):
-        expr = value
-        if isinstance(expr, sympy.Float):
-            expr = sympy.Rational(str(expr))
-        if expr.free_symbols:
-            raise ProblemError(
-                f"{what} = {value} contains the symbols {sorted(map(str, expr.free_symbols))}; "
-                "substitute numbers before building the system"
-            )
-    elif isinstance(value, numbers.Real):
-        return _exact_scalar(float(value), what)
-    else:
-        raise ProblemError(
-            f"{what} has type {type(value).__name__}; give an int, float, fraction, "
-            "exact string like '1/3' or a sympy number"
-        )
-    if not isinstance(expr, sympy.Expr) or not expr.is_number:
-        raise ProblemError(f"{what} = {value!r} is not a number")
-    if expr.is_finite is False or expr.has(sympy.nan, sympy.zoo, sympy.oo, -sympy.oo):
-        raise ProblemError(f"{what} = {value!r} is not finite; every entry must be a finite real number")
-    numeric = complex(sympy.N(expr, 30))
-    if not math.isfinite(numeric.real) or numeric.imag != 0.0 or expr.is_real is False:
-        raise ProblemError(f"{what} = {value!r} is not a finite real number")
-    return expr
+    if isinstance(value, np.generic):
+        value = value.item()
+    return parse_real(value, what=what)
 
 
 def _exact_to_float(expr: sympy.Expr) -> float:
