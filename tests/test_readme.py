@@ -1,8 +1,13 @@
-"""The README's code is true: its doctest blocks pass and its plain Python blocks run."""
+"""The README's code is true: its doctest blocks pass, its plain Python blocks run and its commands run literally."""
 
 import doctest
 import pathlib
 import re
+import shlex
+import shutil
+import subprocess
+
+import pytest
 
 README = pathlib.Path(__file__).resolve().parent.parent / "README.md"
 BLOCKS = re.findall(r"```python\n(.*?)```", README.read_text(encoding="utf-8"), flags=re.S)
@@ -24,3 +29,28 @@ def test_readme_doctests_pass():
 def test_readme_scripts_run():
     for block in (block for block in BLOCKS if ">>>" not in block):
         exec(compile(block, str(README), "exec"), {"__name__": "readme"})  # noqa: S102 - our own README
+
+
+def readme_commands() -> list[str]:
+    """Every `lindstedt …` line of the README's bash blocks (comments stripped)."""
+    text = README.read_text(encoding="utf-8")
+    lines = []
+    for block in re.findall(r"```bash\n(.*?)```", text, flags=re.S):
+        for line in block.splitlines():
+            command = line.split("  #")[0].strip()
+            if command.startswith("lindstedt "):
+                lines.append(command)
+    return lines
+
+
+def test_readme_has_commands():
+    assert any(command.startswith("lindstedt nnm examples/") for command in readme_commands())
+
+
+@pytest.mark.parametrize("command", readme_commands())
+def test_readme_command_runs_literally(command, tmp_path):
+    # run from a copy of the repository's examples in a scratch directory, so written files land there
+    shutil.copytree(README.parent / "examples", tmp_path / "examples")
+    result = subprocess.run(shlex.split(command), cwd=tmp_path, capture_output=True, text=True, timeout=300, check=False)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip()
