@@ -406,8 +406,7 @@ def test_cosine_series_of_ramp_coefficients_reproduces_the_ramp(kappa: str, poin
 
 
 def test_cosine_series_of_absolute_cosine_with_vanishing_odd_terms() -> None:
-    # |cos s| = 2/pi - (4/pi) sum_k (-1)^k cos(2 k s)/(4k^2 - 1); the coefficients themselves
-    # are checked against quadrature in tests/test_quasi_trig.py.
+    # |cos s| = 2/pi - (4/pi) sum_k (-1)^k cos(2 k s)/(4k^2 - 1) (a textbook series).
     def coefficient(n: int) -> mpmath.mpf:
         if n == 0:
             return 2 / mpmath.pi
