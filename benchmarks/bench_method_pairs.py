@@ -92,9 +92,9 @@ def _clear_lindstedt_caches() -> None:
     """Forget every cached hierarchy and memo so the next expansion is computed from scratch ("cold-ish")."""
     import sympy.core.cache
 
-    import lindstedt._api
+    import lindstedt
 
-    lindstedt._api._DEFAULT_METHODS.clear()
+    lindstedt.clear_cache()
     for name, module in list(sys.modules.items()):
         if not name.startswith("lindstedt") or module is None:
             continue

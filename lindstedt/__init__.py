@@ -10,7 +10,7 @@ Examples
 """
 
 from ._all_modes import AllModesFirstOrder, all_modes_first_order
-from ._api import expand
+from ._api import cache_info, clear_cache, expand
 from ._codegen import GeneratedCode, generate_code
 from ._cosine import CosineSeries, SineSeries, solve_harmonic_oscillator
 from ._errors import (
@@ -42,6 +42,8 @@ __version__ = "0.1.0"
 
 __all__ = [
     "expand",
+    "clear_cache",
+    "cache_info",
     "nnm",
     "all_modes_first_order",
     "AllModesFirstOrder",

@@ -5,12 +5,10 @@ from __future__ import annotations
 from typing import Any, Mapping
 
 from ._expansion import Expansion
-from ._hierarchy import LindstedtPoincare, validate_order
+from ._hierarchy import CacheInfo, LindstedtPoincare, cache_info, clear_cache, validate_order
 from ._problem import Oscillator
 
-__all__ = ["expand"]
-
-_DEFAULT_METHODS: dict[tuple[int, bool], LindstedtPoincare] = {}
+__all__ = ["expand", "clear_cache", "cache_info", "CacheInfo"]
 
 
 def expand(
@@ -62,8 +60,5 @@ def expand(
         problem = f
     else:
         problem = Oscillator(f, a0=a0, omega0=omega0, params=params, normalization=normalization)
-    key = (precision, bool(numeric))
-    method = _DEFAULT_METHODS.get(key)
-    if method is None:
-        method = _DEFAULT_METHODS[key] = LindstedtPoincare(precision=precision, numeric=numeric)
-    return method.expand(problem, order)
+    # The hierarchy is taken from the process-wide cache (see lindstedt.clear_cache).
+    return LindstedtPoincare(precision=precision, numeric=numeric).expand(problem, order)
