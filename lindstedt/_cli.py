@@ -25,7 +25,6 @@ failed numerical result has ``null`` values with ``"success": false`` and a mess
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from typing import Any, Sequence
 
@@ -178,13 +177,7 @@ def _command_derive(arguments: argparse.Namespace) -> str:
     return format_derivation(result, arguments.format)
 
 
-def _finite_or_none(value: float) -> float | None:
-    return float(value) if math.isfinite(value) else None
-
-
 def _numeric_nnm(system: Any, arguments: argparse.Namespace) -> tuple[str, int]:
-    import json
-
     from ._nnm_numeric import nnm_point
     from ._parsing import parse_float
 
@@ -199,28 +192,7 @@ def _numeric_nnm(system: Any, arguments: argparse.Namespace) -> tuple[str, int]:
         amplitude = {"energy": parse_float(arguments.energy, what="--energy")}
     result = nnm_point(system, epsilon, arguments.mode, **amplitude)
     status = 0 if result.success else EXIT_FAILED
-    multipliers = [] if result.floquet_multipliers is None else [[_finite_or_none(z.real), _finite_or_none(z.imag)] for z in result.floquet_multipliers]
-    data = {
-        "schema": "lindstedt.nnm-numeric/1",
-        "success": bool(result.success),
-        "status": "converged" if result.success else "failed",
-        "message": result.message,
-        "mode": result.mode,
-        "epsilon": result.epsilon,
-        "frequency": _finite_or_none(result.frequency),
-        "period": _finite_or_none(result.period),
-        "release_position": [_finite_or_none(x) for x in result.release_position],
-        "release_velocity": [_finite_or_none(x) for x in result.release_velocity],
-        "modal_coordinates": [_finite_or_none(x) for x in result.modal_coordinates],
-        "energy": _finite_or_none(result.energy),
-        "floquet_multipliers": multipliers,
-        "stable": result.stable,
-        "newton_iterations": result.newton_iterations,
-        "flow_evaluations": result.flow_evaluations,
-    }
-    if arguments.format == "json":
-        return json.dumps(data, indent=2, allow_nan=False), status
-    return result.summary(), status
+    return (result.to_json() if arguments.format == "json" else result.summary()), status
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -465,6 +465,51 @@ class NNMResult:
         """``u_j(0)``, the release modal coordinate of the NNM's own mode."""
         return float(self.modal_coordinates[self.mode - 1])
 
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready data (schema ``lindstedt.nnm-numeric/1``); NaN and infinities become ``None``.
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> chain = lindstedt.UnilateralSystem.chain(2, unilateral=[(0, 0)])
+        >>> data = lindstedt.nnm_point(chain, 0.05, 1, modal_amplitude=1.0).to_dict()
+        >>> data["success"], data["status"], round(data["frequency"], 6)
+        (True, 'converged', 1.006128)
+        """
+
+        def number(value: Any) -> float | None:
+            return float(value) if math.isfinite(value) else None
+
+        multipliers = [] if self.floquet_multipliers is None else [[number(z.real), number(z.imag)] for z in self.floquet_multipliers]
+        return {
+            "schema": "lindstedt.nnm-numeric/1",
+            "success": bool(self.success),
+            "status": "converged" if self.success else "failed",
+            "message": self.message,
+            "mode": self.mode,
+            "epsilon": number(self.epsilon),
+            "frequency": number(self.frequency),
+            "period": number(self.period),
+            "linear_frequency": number(self.linear_frequency),
+            "release_position": [number(x) for x in self.release_position],
+            "release_velocity": [number(x) for x in self.release_velocity],
+            "modal_coordinates": [number(x) for x in self.modal_coordinates],
+            "energy": number(self.energy),
+            "floquet_multipliers": multipliers,
+            "stable": self.stable,
+            "residual": number(self.residual),
+            "n_switches": self.n_switches,
+            "formulation": self.formulation,
+            "newton_iterations": self.newton_iterations,
+            "flow_evaluations": self.flow_evaluations,
+        }
+
+    def to_json(self, indent: int | None = 2) -> str:
+        """Strict JSON text of :meth:`to_dict` (never NaN)."""
+        import json
+
+        return json.dumps(self.to_dict(), indent=indent, allow_nan=False)
+
     def summary(self) -> str:
         """One line: mode, ε, ω, T, energy, stability, cost."""
         if not self.success:
