@@ -47,7 +47,7 @@ import sympy
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.numpy import NumPyPrinter
 
-from ._errors import LindstedtError
+from ._errors import LindstedtError, ProblemError
 
 __all__ = ["GeneratedCode", "generate_code"]
 
@@ -212,19 +212,23 @@ def generate_code(expansion: Any, quantity: str = "frequency", language: str = "
     >>> code.arguments
     ('epsilon', 'a0', 'omega0')
     """
-    if not hasattr(expansion, "frequency_expr"):  # an N-dof NNM: numeric coefficients, no free parameters
+    from ._expansion import EPSILON, TIME, Expansion
+    from ._nnm_expansion import NNMExpansion
+
+    if isinstance(expansion, NNMExpansion):  # numeric coefficients, no free parameters
         return _nnm_code(expansion, quantity, language)
+    if not isinstance(expansion, Expansion):
+        raise ProblemError(f"generate_code takes an Expansion (lindstedt.expand) or an NNMExpansion (lindstedt.nnm), got {type(expansion).__name__}")
     coefficient = _coefficient_index(quantity)
     if quantity not in _QUANTITIES and coefficient is None:
-        raise ValueError(f"quantity must be one of {_QUANTITIES} or 'omega<k>' (e.g. 'omega2')")
+        raise ProblemError(f"quantity must be one of {_QUANTITIES} or 'omega<k>' (e.g. 'omega2')")
     if language not in _LANGUAGES:
-        raise ValueError(f"language must be one of {_LANGUAGES}")
-    from ._expansion import EPSILON, TIME
+        raise ProblemError(f"language must be one of {_LANGUAGES}")
 
     parameters = list(expansion.arguments)
     if coefficient is not None:
         if not parameters:
-            raise ValueError(f"{quantity} of this expansion is a constant ({expansion.omega_correction(coefficient)}); nothing to vectorise")
+            raise ProblemError(f"{quantity} of this expansion is a constant ({expansion.omega_correction(coefficient)}); nothing to vectorise")
         # A single coefficient is worth simplifying once (e.g. ω_2(κ) shrinks several-fold).
         vector = parameters[0]
         expression = _horner_form(sympy.simplify(expansion.omega_correction(coefficient)), vector)
@@ -274,12 +278,12 @@ def _nnm_code(result: Any, quantity: str, language: str) -> GeneratedCode:
     from ._expansion import EPSILON
 
     if quantity != "frequency":
-        raise ValueError(
+        raise ProblemError(
             "for an N-dof NNM only quantity='frequency' is generated (its waveform is vector valued: "
             "use NNMExpansion.displacement)"
         )
     if language not in _LANGUAGES:
-        raise ValueError(f"language must be one of {_LANGUAGES}")
+        raise ProblemError(f"language must be one of {_LANGUAGES}")
     digits = result._hierarchy.digits
     expression = sympy.Add(*[sympy.Float(str(value), digits) * EPSILON**n for n, value in enumerate(result.omega)])
     return _generated(language, quantity, [EPSILON], EPSILON, _horner_form(expression, EPSILON))
