@@ -58,36 +58,6 @@ _RESONANCE_TOLERANCE = 1e-9
 _GRAZING_TOLERANCE = 1e-12
 
 
-def _modes_high_precision(system: UnilateralSystem, digits: int) -> tuple[list[Any], list[list[Any]]]:
-    """λ (increasing) and Φ (columns, ΦᵀMΦ = I, largest entry positive) with mpmath at ``digits``."""
-    def number(value: sympy.Expr) -> Any:
-        return mpmath.mpf(value.p) / value.q if value.is_Rational else mpmath.mpf(sympy.N(value, digits + 5))
-
-    with mpmath.workdps(digits):
-        mass = mpmath.matrix([[number(v) for v in row] for row in system.M_exact.tolist()])
-        stiffness = mpmath.matrix([[number(v) for v in row] for row in system.K_exact.tolist()])
-        lower = mpmath.cholesky(mass)
-        inverse_lower = mpmath.inverse(lower)
-        symmetric = inverse_lower * stiffness * inverse_lower.T
-        symmetric = (symmetric + symmetric.T) / 2
-        eigenvalues, eigenvectors = mpmath.eigsy(symmetric)
-        order = sorted(range(len(eigenvalues)), key=lambda i: eigenvalues[i])
-        shapes_matrix = inverse_lower.T * eigenvectors
-        size = system.n_dof
-        frequencies = []
-        shapes = []
-        for index in order:
-            frequencies.append(mpmath.sqrt(eigenvalues[index]))
-            column = [shapes_matrix[row, index] for row in range(size)]
-            largest = max(abs(value) for value in column)
-            for value in column:  # first entry of largest magnitude (ties within 1e-9) is positive
-                if abs(value) >= largest * (1 - mpmath.mpf("1e-9")):
-                    sign = 1 if value > 0 else -1
-                    break
-            shapes.append([sign * value for value in column])
-        return frequencies, shapes
-
-
 @dataclass(frozen=True)
 class _SpringAtOrderZero:
     index: int
@@ -137,7 +107,7 @@ class _ModalHierarchy(LazyOrders):
         self._domain = domain
         size = system.n_dof
         self.size = size
-        frequencies, shapes = _modes_high_precision(system, digits + 10)
+        frequencies, shapes = system.modes_high_precision(digits + 10)
 
         def convert(value: Any) -> Any:
             return domain.from_sympy(sympy.Float(value, digits + 10)) if not isinstance(value, sympy.Basic) else domain.from_sympy(sympy.N(value, digits + 10))

@@ -26,6 +26,7 @@ from fractions import Fraction
 from functools import cached_property
 from typing import Any, Iterable, Mapping, NamedTuple, Sequence
 
+import mpmath
 import numpy as np
 import scipy.linalg
 import sympy
@@ -55,6 +56,15 @@ class Modes(NamedTuple):
 
     frequencies: np.ndarray
     shapes: np.ndarray
+
+
+def _leading_sign(column: Sequence[Any]) -> int:
+    """±1 making the first entry of largest magnitude (ties within a relative 1e-9) positive."""
+    largest = max(abs(value) for value in column)
+    for value in column:
+        if abs(value) >= largest * (1 - _MODE_SIGN_TIE_RTOL):
+            return 1 if value > 0 else -1
+    return 1
 
 
 # --------------------------------------------------------------------------- #
@@ -450,14 +460,45 @@ class UnilateralSystem:
         frequencies = np.sqrt(squared)
         shapes = np.array(shapes)
         for k in range(self.n_dof):
-            column = shapes[:, k]
-            magnitudes = np.abs(column)
-            leader = int(np.argmax(magnitudes >= magnitudes.max() * (1.0 - _MODE_SIGN_TIE_RTOL)))
-            if column[leader] < 0:
-                shapes[:, k] = -column
+            shapes[:, k] *= _leading_sign(shapes[:, k].tolist())
         frequencies.setflags(write=False)
         shapes.setflags(write=False)
         return Modes(frequencies, shapes)
+
+    def modes_high_precision(self, digits: int) -> tuple[list[Any], list[list[Any]]]:
+        """The modes of :meth:`modes` computed from the exact matrices with mpmath at ``digits`` digits.
+
+        Returns
+        -------
+        frequencies : list of mpmath.mpf
+            λ_1 ≤ … ≤ λ_N.
+        shapes : list of lists of mpmath.mpf
+            ``shapes[k]`` is the mode shape of λ_{k+1} (ΦᵀMΦ = I), signed by the convention of :meth:`modes`.
+
+        Examples
+        --------
+        >>> import mpmath
+        >>> lam, phi = UnilateralSystem.chain(2).modes_high_precision(30)
+        >>> mpmath.nstr(lam[1], 25)
+        '1.732050807568877293527446'
+        """
+        def number(value: sympy.Expr) -> Any:
+            return mpmath.mpf(value.p) / value.q if value.is_Rational else mpmath.mpf(sympy.N(value, digits + 5))
+
+        with mpmath.workdps(digits):
+            mass = mpmath.matrix([[number(v) for v in row] for row in self.M_exact.tolist()])
+            stiffness = mpmath.matrix([[number(v) for v in row] for row in self.K_exact.tolist()])
+            inverse_lower = mpmath.inverse(mpmath.cholesky(mass))
+            symmetric = inverse_lower * stiffness * inverse_lower.T
+            eigenvalues, eigenvectors = mpmath.eigsy((symmetric + symmetric.T) / 2)
+            shapes_matrix = inverse_lower.T * eigenvectors
+            frequencies, shapes = [], []
+            for index in sorted(range(len(eigenvalues)), key=lambda i: eigenvalues[i]):
+                frequencies.append(mpmath.sqrt(eigenvalues[index]))
+                column = [shapes_matrix[row, index] for row in range(self.n_dof)]
+                sign = _leading_sign(column)
+                shapes.append([sign * value for value in column])
+            return frequencies, shapes
 
     def modes(self) -> Modes:
         """Linear normal modes: ``K Φ = M Φ diag(λ²)`` with ``Φᵀ M Φ = I``.
