@@ -447,7 +447,7 @@ def test_divergent_series_raises_convergence_error() -> None:
 
 @pytest.mark.parametrize(
     "kwargs",
-    [{"dps": 3}, {"methods": ("euler",)}, {"methods": ()}, {"block_size": 0}, {"start": -1}],
+    [{"dps": 3}, {"methods": ("euler",)}, {"methods": ()}, {"block_size": 0}, {"start": -1}, {"max_terms": 10}],
 )
 def test_series_sum_rejects_bad_options(kwargs: dict) -> None:
     with pytest.raises(ProblemError):
@@ -474,3 +474,56 @@ def test_geometric_series() -> None:
     with mpmath.workdps(30):
         assert abs(value - mpmath.mpf(2) / 3) <= max(error, mpmath.mpf(10) ** -24)
         assert abs(value - mpmath.mpf(2) / 3) <= mpmath.mpf(10) ** -22
+
+
+def _clausen_four(theta: mpmath.mpf) -> mpmath.mpf:
+    # sum_{k >= 1} cos(k theta) / k^4 for 0 <= theta <= 2 pi (Bernoulli polynomial B_4)
+    return mpmath.pi**4 / 90 - mpmath.pi**2 * theta**2 / 12 + mpmath.pi * theta**3 / 12 - theta**4 / 48
+
+
+@pytest.mark.parametrize(("theta", "max_terms"), [(1, 200), (2, 300)])
+def test_error_estimate_bounds_the_error_when_max_terms_is_reached(theta: int, max_terms: int) -> None:
+    # A monotone plus an oscillating k^-4 tail (like the omega2 series of the benchmark):
+    # nsum's stopping rule is not met, its best values scatter, and the estimate must
+    # still bound the actual error (a driver comparing two runs claimed 1.1e-10 for 1.3e-10).
+    with mpmath.workdps(50):
+        exact = _clausen_four(mpmath.mpf(0)) + _clausen_four(mpmath.mpf(theta))
+
+    def term(k: int) -> mpmath.mpf:
+        return (1 + mpmath.cos(k * theta)) / mpmath.mpf(k) ** 4
+
+    estimate = series_sum(term, start=1, dps=20, max_terms=max_terms, tolerance=1e-6)
+    assert estimate.method.endswith("max_terms reached")
+    with mpmath.workdps(50):
+        actual_error = abs(estimate.value - exact)
+    assert actual_error <= estimate.error_estimate <= mpmath.mpf(10) ** -7
+
+
+def test_vanishing_odd_terms_do_not_stop_the_summation() -> None:
+    # kappa = 0: c_k vanishes for odd k >= 3, so the 10th term is 0; summing stops there
+    # unless vanishing terms are skipped (a 10-term partial sum is off by 4e-4).
+    def coefficient(k: int) -> mpmath.mpf:
+        return contact_ramp_coefficient_mp(k, 0, dps=40)
+
+    estimate = sum_cosine_series_at(coefficient, "0.5", dps=20)
+    with mpmath.workdps(40):
+        actual_error = abs(estimate.value - mpmath.cos(mpmath.mpf("0.5")))
+    assert estimate.terms_used > 100
+    assert actual_error <= estimate.error_estimate <= mpmath.mpf(10) ** -15
+
+
+def test_working_precision_is_set_inside_and_does_not_leak() -> None:
+    seen = []
+
+    def term(k: int) -> mpmath.mpf:
+        assert isinstance(k, int)
+        seen.append(mpmath.mp.dps)
+        return mpmath.mpf(1) / k**2
+
+    before = mpmath.mp.dps
+    value, error = series_sum(term, start=1, dps=40)
+    assert mpmath.mp.dps == before
+    assert min(seen) >= 40
+    with mpmath.workdps(60):
+        assert abs(value - mpmath.pi**2 / 6) <= max(error, mpmath.mpf(10) ** -39)
+        assert abs(value - mpmath.pi**2 / 6) <= mpmath.mpf(10) ** -35
