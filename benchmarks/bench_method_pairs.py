@@ -19,7 +19,7 @@ with an independent exact reference at high precision:
 Every problem runs in its own fresh interpreter (this file doubles as its worker: ``python -I
 bench_method_pairs.py --worker NAME [--quick]`` prints one ``@@BENCH-RESULT {json}`` line).  Timing is
 ``time.perf_counter`` inside that process, minimum over repeats; what each time covers is stated in the
-section.  The figures are SVG files in ``benchmarks/figures/`` drawn with ``lindstedt._svg.line_plot_svg``
+section.  The figures are SVG files in ``benchmarks/figures/`` drawn with ``lindstedt.validate.line_plot_svg``
 (log10 taken here for log–log axes).
 
 Standalone: ``python benchmarks/bench_method_pairs.py [--quick]`` prints the markdown section.
@@ -254,8 +254,7 @@ def _worker_duffing(config: dict) -> dict:
     from scipy.integrate import solve_ivp
 
     import lindstedt
-    from lindstedt._reference_duffing import duffing_exact_frequency
-    from lindstedt._reference_quadrature import conservative_frequency
+    from lindstedt.references import conservative_frequency, duffing_exact_frequency
 
     u = sympy.Symbol("u")
     repeats = config["repeats"]
@@ -333,7 +332,7 @@ def _worker_unilateral(config: dict) -> dict:
     import mpmath
 
     import lindstedt
-    from lindstedt._reference_piecewise import piecewise_linear_exact_frequency
+    from lindstedt.references import piecewise_linear_exact_frequency
 
     repeats = config["repeats"]
     kappa = Fraction(KAPPA)
@@ -501,7 +500,7 @@ def _figure(path: Path, curves: list[tuple[list[float], list[float], str]], *, t
     """Log–log SVG: ``line_plot_svg`` on log10 data, then post-processed here: a longer palette (dashed from
     the fifth curve on), a marker at every point (a one-point curve is otherwise invisible) and the legend
     moved into a panel right of the plot so that it never hides data; ``notes`` go under the legend."""
-    from lindstedt._svg import line_plot_svg
+    from lindstedt.validate import line_plot_svg
 
     width, height, margin_top, panel = 680, 460, 40, 330
     svg = line_plot_svg([(list(map(float, x)), list(map(float, y)), label) for x, y, label in curves],

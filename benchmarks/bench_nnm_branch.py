@@ -1,6 +1,6 @@
 """Benchmark: NNM branches of 20-dof systems — pseudo-arclength vs the seed's algorithm; exact flow vs DOP853.
 
-Problem: ``M X'' + K X + ε W (A X − b)_+ = 0`` (``lindstedt._nnm_numeric``).
+Problem: ``M X'' + K X + ε W (A X − b)_+ = 0`` (``lindstedt.numerics``).
 
 Part 1 — branches (20 dof, ≈ 50 points each).  Both methods follow the same branch over the same range:
 
@@ -94,8 +94,8 @@ def _log(message: str) -> None:
 # workers (run in fresh interpreters: python -I bench_nnm_branch.py --worker KIND JSON)
 # ---------------------------------------------------------------------------------------------------------------
 def _system(spec: list[Any]):
-    from lindstedt._nnm_numeric import seed_example_system
-    from lindstedt._system import UnilateralSystem
+    from lindstedt import UnilateralSystem
+    from lindstedt.numerics import seed_example_system
 
     kind, size = spec
     if kind == "seed":
@@ -110,7 +110,7 @@ def _worker_branch(params: dict[str, Any]) -> dict[str, Any]:
 
     import numpy as np
 
-    from lindstedt._nnm_numeric import continue_nnm
+    from lindstedt.numerics import continue_nnm
 
     system = _system(params["system"])
     lam, phi = system.modes()
@@ -189,8 +189,7 @@ def _dop853_with_restarts(system, epsilon: float, x0, v0, t_end: float, rtol: fl
 def _worker_flow(params: dict[str, Any]) -> dict[str, Any]:
     import numpy as np
 
-    from lindstedt._flow import ExactFlow
-    from lindstedt._nnm_numeric import nnm_energy, nnm_point
+    from lindstedt.numerics import ExactFlow, nnm_energy, nnm_point
 
     system = _system(params["system"])
     epsilon = params["epsilon"]
@@ -237,7 +236,7 @@ def _worker_flow(params: dict[str, Any]) -> dict[str, Any]:
 def _worker_seed_examples(params: dict[str, Any]) -> dict[str, Any]:
     import numpy as np
 
-    from lindstedt._nnm_numeric import nnm_point, seed_example_system
+    from lindstedt.numerics import nnm_point, seed_example_system
 
     rows = []
     for example in SEED_EXAMPLES:

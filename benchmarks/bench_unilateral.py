@@ -5,7 +5,7 @@ bench_unilateral.py --worker TASK ...`` prints one ``@@BENCH-RESULT {json}`` lin
 
 1. ``numeric=True`` (30-digit floats) ω1…ω4 at numeric κ: warm time = the first call for a NEW κ after one
    warm-up call with another κ (imports and code paths warm, no result-cache hit); accuracy vs the
-   independent reference (Cauchy integral on the closed-form period, ``lindstedt._reference_piecewise``).
+   independent reference (Cauchy integral on the closed-form period, ``lindstedt.references``).
 2. closed-form symbolic ω2(κ), ω3(κ): cold time in a fresh process.
 3. generated vectorised ω2(κ) (NumPy and C) over 10⁶ κ vs ``np.arccos(x) + np.sqrt(1 - x*x)`` on the same
    array, min of 5, same process; accuracy at sample κ, interior and near ±1.
@@ -303,7 +303,7 @@ def _worker_series(kappa_text: str, truncations: list[int], mp_truncations: list
     import sympy
 
     import lindstedt
-    from lindstedt._contact_fourier import series_sum
+    from lindstedt.algebra import series_sum
 
     kappa = Fraction(kappa_text)
     kappa_float = float(kappa)
@@ -394,7 +394,7 @@ def _call(task: str, *args: Any, timeout: float = 300) -> dict[str, Any]:
 def _reference(kappa: Fraction, order: int) -> list[tuple[Any, Any]]:
     import mpmath
 
-    from lindstedt._reference_piecewise import piecewise_linear_frequency_taylor
+    from lindstedt.references import piecewise_linear_frequency_taylor
 
     with mpmath.workdps(REFERENCE_DPS + 20):
         b = mpmath.mpf(kappa.numerator) / kappa.denominator
@@ -564,7 +564,7 @@ def run(quick: bool = False) -> str:
     w(f"## {TITLE}")
     w("")
     w("Problem: `u'' + u + ε (u − b)_+ = 0`, `u(0) = 1`, `u'(0) = 0` (a0 = ω0 = 1, κ = b), ω(ε) = Σ ω_k ε^k. "
-      "Reference for every error below: `lindstedt._reference_piecewise.piecewise_linear_frequency_taylor` "
+      "Reference for every error below: `lindstedt.references.piecewise_linear_frequency_taylor` "
       f"(Taylor coefficients of the exact frequency by a Cauchy integral on the closed-form period, {REFERENCE_DPS} "
       "digits, its own error estimate far below the errors that matter here), evaluated at the exact rational "
       "value of each κ (for κ given as doubles: the exact value of the double, so input rounding is not counted "
@@ -719,8 +719,8 @@ def run(quick: bool = False) -> str:
     w("* *truncated, float*: harmonics k = 2…N of the series above in NumPy doubles (vectorised over k; the "
       "coefficients are computed inside the timed call); min of several calls.")
     w("* *truncated, mpmath*: the same series summed term by term at 30 digits (sines cached: one `sin` per k).")
-    w("* *`series_sum`*: `lindstedt._contact_fourier.series_sum(term, start=2, dps=D)` — Richardson / Shanks (Wynn ε) "
-      "/ Levin-u acceleration, run twice at two precisions; its own error estimate is shown.")
+    w("* *`series_sum`*: `lindstedt.algebra.series_sum(term, start=2, dps=D)` — `mpmath.nsum` (Richardson + Shanks) "
+      "checked by a second sum at 10 more digits; its own error estimate is shown.")
     w("* *numeric engine*: `lindstedt.expand(..., numeric=True, precision=30)` at order 2 for a new κ after a "
       "warm-up call (as in table 1).")
     w("* *closed form ω2(κ)*: the exact symbolic ω2(κ) (derived once, untimed here — see table 2) evaluated with "

@@ -1,6 +1,17 @@
 """lindstedt: exact Lindstedt–Poincaré (strained coordinates) expansions of weakly nonlinear oscillators.
 
-The public API is re-exported here; everything else is private.
+The public API is re-exported here and in the documented public subpackages:
+
+* :mod:`lindstedt.references` — independent exact references (Duffing, unilateral
+  spring, quadrature of a conservative oscillator, NNM release amplitudes);
+* :mod:`lindstedt.validate` — expansions against the true solution (errors,
+  convergence orders, validity times, contact measure, spectra);
+* :mod:`lindstedt.algebra` — the exact algebra (cosine series, the contact Fourier
+  kernel of ``(cos s − κ)_+`` and ``H(cos s − κ)``, truncated power series);
+* :mod:`lindstedt.numerics` — the exact piecewise-linear flow and NNMs by shooting;
+* :mod:`lindstedt.cli` — the ``lindstedt`` command (``python -m lindstedt``).
+
+Modules whose names start with an underscore are private.
 
 Examples
 --------
@@ -11,7 +22,7 @@ Examples
 
 from ._all_modes import AllModesFirstOrder, all_modes_first_order
 from ._api import cache_info, clear_cache, expand
-from ._codegen import GeneratedCode, generate_code
+from ._codegen import CodeGenerationError, GeneratedCode, generate_code
 from ._cosine import CosineSeries, SineSeries, solve_harmonic_oscillator
 from ._errors import (
     ConvergenceError,
@@ -85,4 +96,5 @@ __all__ = [
     "OrderError",
     "ResonanceError",
     "ConvergenceError",
+    "CodeGenerationError",
 ]

@@ -99,12 +99,15 @@ def build_parser() -> argparse.ArgumentParser:
     nnm.add_argument("--precision", type=int, default=30, help="decimal digits of the arithmetic (default 30)")
     nnm.add_argument("--format", choices=("text", "latex", "json"), default="text")
 
-    derive = commands.add_parser("derive", help="run a named derivation (LaTeX fragment + JSON coefficients)")
-    derive.add_argument("name", nargs="?", help="derivation name (see --list)")
-    derive.add_argument("--list", action="store_true", help="list the named derivations")
-    derive.add_argument("--order", type=int, default=None, help="expansion order (default: the derivation's own)")
-    derive.add_argument("--format", choices=("text", "latex", "json"), default="text")
-    derive.add_argument("--output", default=None, help="directory to write NAME.tex and NAME.json into")
+    derive = commands.add_parser(
+        "derive", help="run a worked example of the source tree's derivations/ (LaTeX fragment + JSON coefficients)"
+    )
+    derive.add_argument("name", nargs="?", help="derivation name: the script derivations/NAME.py (see --list)")
+    derive.add_argument("--list", action="store_true", help="list the scripts in derivations/ with their first docstring line")
+    derive.add_argument("--order", type=int, default=None, help="expansion order (default: the script's own)")
+    derive.add_argument("--format", choices=("text", "latex", "json"), default="text",
+                        help="print the coefficients and checks (text), the LaTeX fragment or the JSON (default text)")
+    derive.add_argument("--output", default=None, help="directory to write NAME.tex and NAME.json into (default: write nothing)")
 
     demo = commands.add_parser("demo", help="the tour: Duffing and u_+ expansions checked against exact references")
     demo.add_argument("--order", type=int, default=8, help="Duffing order to derive (default 8)")
@@ -166,15 +169,35 @@ def _refuse_json_constant(name: str) -> None:
     raise ProblemError(f"the system file contains {name}; every entry must be a finite real number")
 
 
-def _command_derive(arguments: argparse.Namespace) -> str:
-    from ._derive import derive, format_derivation, list_derivations
+def _command_derive(arguments: argparse.Namespace) -> str | tuple[str, int]:
+    """Run ``derivations/NAME.py`` of the source tree in this process, through its helper ``derivations/_common.py``."""
+    import importlib.util
+    from pathlib import Path
 
+    import lindstedt
+
+    directory = Path(lindstedt.__file__).resolve().parent.parent / "derivations"
+    helper = directory / "_common.py"
+    if not helper.is_file():
+        raise ProblemError(
+            f"the derivations ship with the source tree, not with the installed package (no {helper}); "
+            "run `lindstedt derive` from an editable install of a checkout (pip install -e .), "
+            "or run `python derivations/NAME.py` there"
+        )
+    key = "lindstedt_derivations_common"  # the name the scripts load their helper under
+    common = sys.modules.get(key)
+    if common is None or Path(common.__file__).resolve() != helper:
+        spec = importlib.util.spec_from_file_location(key, helper)
+        common = importlib.util.module_from_spec(spec)
+        sys.modules[key] = common
+        spec.loader.exec_module(common)
     if arguments.list:
-        return "\n".join(f"{name:18s} {description}" for name, description in list_derivations())
+        return "\n".join(f"{name:18s} {description}" for name, description in common.list_derivations(directory))
     if not arguments.name:
         raise ProblemError("name a derivation (lindstedt derive --list shows them)")
-    result = derive(arguments.name, order=arguments.order, output_directory=arguments.output)
-    return format_derivation(result, arguments.format)
+    result = common.run_script(arguments.name, order=arguments.order, output=arguments.output, directory=directory)
+    text = common.render(result, arguments.format)
+    return text if result.agrees else (text, EXIT_FAILED)
 
 
 def _numeric_nnm(system: Any, arguments: argparse.Namespace) -> tuple[str, int]:

@@ -5,9 +5,8 @@ import pytest
 from scipy.optimize import minimize_scalar
 
 import lindstedt
-from lindstedt import ProblemError, UnilateralSystem
-from lindstedt._all_modes import all_modes_first_order
-from lindstedt._flow import ExactFlow
+from lindstedt import ProblemError, UnilateralSystem, all_modes_first_order
+from lindstedt.numerics import ExactFlow
 
 
 def test_zero_gaps_closed_form_is_a_kk_over_4_lambda_k():

@@ -18,10 +18,9 @@ import tempfile
 
 import numpy as np
 import pytest
-import sympy
 
 import lindstedt
-from lindstedt._codegen import CodeGenerationError, GeneratedCode
+from lindstedt import CodeGenerationError, GeneratedCode
 
 COMPILER = shutil.which("cc") or shutil.which("gcc")
 needs_compiler = pytest.mark.skipif(COMPILER is None, reason="no C compiler (cc or gcc) on PATH")
@@ -215,14 +214,13 @@ def test_failed_build_leaves_no_partial_files(cache):
 @needs_compiler
 @pytest.mark.parametrize("where", ["compiler", "rename"])
 def test_interrupted_build_leaves_no_partial_files(cache, monkeypatch, where):
-    from lindstedt import _codegen
-
+    # interrupt the build from the outside: the compiler run (subprocess.run) or the final rename (os.replace)
     with monkeypatch.context() as patch:
         if where == "compiler":
             def interrupted(*args, **kwargs):
                 raise KeyboardInterrupt
 
-            patch.setattr(_codegen.subprocess, "run", interrupted)
+            patch.setattr(subprocess, "run", interrupted)
         else:
             replace = os.replace
 
@@ -231,7 +229,7 @@ def test_interrupted_build_leaves_no_partial_files(cache, monkeypatch, where):
                     raise KeyboardInterrupt
                 replace(source, target)
 
-            patch.setattr(_codegen.os, "replace", interrupted)
+            patch.setattr(os, "replace", interrupted)
         with pytest.raises(KeyboardInterrupt):
             _code().compile()
     assert _no_partial_files(cache)
@@ -269,16 +267,22 @@ def test_reserved_parameter_names_round_trip(name, language, cache):
     np.testing.assert_allclose(generated, expansion.frequency(0.1, values=values), rtol=1e-13, atol=0)
 
 
-def test_mangled_names_stay_distinct():
-    from lindstedt._codegen import _C_RESERVED, _PYTHON_RESERVED, _safe_names
-
-    double, double_, lam = (sympy.Symbol(n, real=True) for n in ("double", "double_", "lambda"))
-    c_names = {s.name: r.name for s, r in _safe_names([double, double_, lam], _C_RESERVED).items()}
-    assert c_names == {"double": "double__", "double_": "double_", "lambda": "lambda"}
-    python_names = {s.name: r.name for s, r in _safe_names([double, double_, lam], _PYTHON_RESERVED).items()}
-    assert python_names == {"double": "double", "double_": "double_", "lambda": "lambda_"}
-    renamed = _safe_names([double], _C_RESERVED)[double]
-    assert renamed.is_real and renamed.name == "double_"
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_mangled_names_stay_distinct(language, cache):
+    # `double` is reserved in C only, `float` in both; a mangled name never takes another parameter's name
+    expansion = lindstedt.expand("u**3 + double*u**5 + double_*u**7 + float*u**9", order=2,
+                                 params={"double": None, "double_": None, "float": None})
+    code = lindstedt.generate_code(expansion, "frequency", language)
+    assert code.arguments[0] == "epsilon"
+    names = dict(zip((str(symbol) for symbol in expansion.arguments), code.arguments[1:], strict=True))
+    if language == "c":
+        assert (names["double"], names["double_"], names["float"]) == ("double__", "double_", "float_")
+    else:
+        assert (names["double"], names["double_"], names["float"]) == ("double", "double_", "float_")
+    assert len(set(code.arguments)) == len(code.arguments)
+    values = {"a0": 1, "omega0": 1, "double": 0.5, "double_": -0.25, "float": 0.125}
+    generated = code.compile()(0.1, *[values[str(symbol)] for symbol in expansion.arguments])
+    np.testing.assert_allclose(generated, expansion.frequency(0.1, values=values), rtol=1e-13, atol=0)
 
 
 def test_internal_names_cannot_be_parameter_names():

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from scipy.integrate import quad
 
 import lindstedt
-from lindstedt._contact_fourier import contact_ramp_coefficient, contact_ramp_coefficients_float
+from lindstedt.algebra import contact_ramp_coefficient, contact_ramp_coefficients_float
 
 
 @settings(max_examples=40, deadline=None)

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from sympy import QQ, Rational
 
 from lindstedt import CosineSeries, solve_harmonic_oscillator
-from lindstedt._cosine import SecularTermError
+from lindstedt.algebra import SecularTermError
 
 s = sympy.Symbol("s", real=True)
 

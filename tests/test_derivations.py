@@ -1,17 +1,18 @@
-"""The named derivations (``lindstedt._derive`` and ``derivations/*.py``).
+"""The worked examples ``derivations/*.py`` (with their helper ``derivations/_common.py``) and ``lindstedt derive``.
 
-Every registered case runs at a small order, writes LaTeX with balanced
-environments and braces and parsable JSON with ``"omega"``, and its numbers —
-read back from the JSON text — agree with an independent reference: the exact
-Duffing series (elliptic K), the exact u_+ period series, the Cauchy-integral
-Taylor coefficients of the exact piecewise-linear period (1e-20), analytic
-chain frequencies and the zero-gap closed form of Theorem 4.3.  Every script
-also runs as a subprocess.
+Every script runs at a small order, writes LaTeX with balanced environments and
+braces and parsable JSON with ``"omega"``, and its numbers — read back from the
+JSON text — agree with an independent reference: the exact Duffing series
+(elliptic K), the exact u_+ period series, the Cauchy-integral Taylor
+coefficients of the exact piecewise-linear period (1e-20), analytic chain
+frequencies and the zero-gap closed form of Theorem 4.3.  Every script also runs
+as a subprocess, and ``lindstedt derive`` lists and runs them.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import importlib.util
 import json
 import re
 import subprocess
@@ -22,10 +23,14 @@ import mpmath
 import pytest
 import sympy
 
+import lindstedt
 from lindstedt import OrderError, ProblemError
-from lindstedt._derive import DERIVATIONS, DerivationResult, derive, format_derivation, list_derivations
-from lindstedt._reference_duffing import duffing_frequency_taylor
-from lindstedt._reference_piecewise import piecewise_linear_frequency_taylor, piecewise_linear_frequency_taylor_symbolic
+from lindstedt.cli import main
+from lindstedt.references import (
+    duffing_frequency_taylor,
+    piecewise_linear_frequency_taylor,
+    piecewise_linear_frequency_taylor_symbolic,
+)
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 SCRIPTS = REPOSITORY / "derivations"
@@ -47,31 +52,43 @@ KAPPA, BETA, SIGMA = sympy.Symbol("kappa", real=True), sympy.Symbol("beta", posi
 LOCALS = {"a0": A0, "omega0": OMEGA0, "a": A, "kappa": KAPPA, "beta": BETA, "sigma": SIGMA}
 
 
+def _helper():
+    """derivations/_common.py under the name the scripts and ``lindstedt derive`` load it with."""
+    key = "lindstedt_derivations_common"
+    if key not in sys.modules:
+        spec = importlib.util.spec_from_file_location(key, SCRIPTS / "_common.py")
+        sys.modules[key] = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(sys.modules[key])
+    return sys.modules[key]
+
+
+common = _helper()
+derive = common.run_script
+
+
 def parse(text: str) -> sympy.Expr:
     return sympy.sympify(text, locals=LOCALS)
 
 
 @pytest.fixture(scope="module")
-def results(tmp_path_factory) -> dict[str, DerivationResult]:
-    """Each derivation at its small order, written into one temporary directory (computed once)."""
+def results(tmp_path_factory) -> dict:
+    """Each script's derivation at its small order, in this process, written into one temporary directory (computed once)."""
     directory = tmp_path_factory.mktemp("derivations")
-    return {name: derive(name, order=SMALL_ORDER[name], output_directory=directory) for name in NAMES}
+    return {name: derive(name, order=SMALL_ORDER[name], output=directory) for name in NAMES}
 
 
 # --------------------------------------------------------------------------- #
 # registry and API
 # --------------------------------------------------------------------------- #
-def test_registry_lists_the_named_cases_in_order_with_one_line_descriptions():
-    assert [name for name, _ in list_derivations()] == NAMES
-    for name, description in list_derivations():
+def test_every_script_is_listed_by_name_with_its_docstring_first_line():
+    assert [name for name, _ in common.list_derivations()] == sorted(NAMES)
+    for name, description in common.list_derivations():
         assert description and "\n" not in description
-        spec = DERIVATIONS[name]
-        assert spec.name == name and spec.description == description
-        assert 1 <= spec.default_order <= spec.max_order
-    with pytest.raises(TypeError):
-        DERIVATIONS["new"] = DERIVATIONS["gap"]  # read-only mapping
-    with pytest.raises(dataclasses.FrozenInstanceError):
-        DERIVATIONS["gap"].default_order = 7
+        module = common.load(name)
+        assert module.__doc__.strip().splitlines()[0] == description
+        highest = getattr(module, "MAX_ORDER", None)
+        assert 1 <= module.DEFAULT_ORDER and (highest is None or module.DEFAULT_ORDER <= highest)
+        assert callable(module.derive)
 
 
 def test_bad_requests_raise_typed_errors_naming_the_fix():
@@ -89,7 +106,7 @@ def test_bad_requests_raise_typed_errors_naming_the_fix():
 def test_without_output_directory_nothing_is_written_and_formats_select_files(tmp_path):
     quiet = derive("grazing", order=1)
     assert quiet.paths == () and quiet.order == 1 and quiet.name == "grazing"
-    only_json = derive("grazing", order=1, output_directory=tmp_path / "new" / "dir", formats=("json",))
+    only_json = derive("grazing", order=1, output=tmp_path / "new" / "dir", formats=("json",))
     assert only_json.paths == (tmp_path / "new" / "dir" / "grazing.json",)
     assert [path.name for path in (tmp_path / "new" / "dir").iterdir()] == ["grazing.json"]
     with pytest.raises(dataclasses.FrozenInstanceError):
@@ -97,18 +114,19 @@ def test_without_output_directory_nothing_is_written_and_formats_select_files(tm
 
 
 def test_default_order_comes_from_the_spec():
-    assert derive("all_modes").order == DERIVATIONS["all_modes"].default_order == 1
+    assert derive("all_modes").order == common.load("all_modes").DEFAULT_ORDER == 1
 
 
-def test_format_derivation(results):
+def test_render(results):
     result = results["gap"]
-    assert format_derivation(result, "latex") == result.latex.rstrip("\n")
-    assert json.loads(format_derivation(result, "json")) == result.json
-    text = format_derivation(result, "text")
+    assert common.render(result, "latex") == result.latex.rstrip("\n")
+    assert json.loads(common.render(result, "json")) == result.json
+    text = common.render(result, "text")
     assert text.startswith("gap (order 2)")
     assert all(str(path) in text for path in result.paths)
+    assert result.json["omega"]["kappa = 1/3"][1] in text  # the coefficients are printed
     with pytest.raises(ProblemError):
-        format_derivation(result, "pdf")
+        common.render(result, "pdf")
 
 
 # --------------------------------------------------------------------------- #
@@ -267,39 +285,53 @@ def test_all_modes_zero_gap_corrections_equal_the_closed_form(results):
 # --------------------------------------------------------------------------- #
 # the scripts
 # --------------------------------------------------------------------------- #
-def test_every_script_runs_and_prints_where_it_wrote(tmp_path):
+def test_every_script_runs_from_any_directory_and_prints_its_coefficients_checks_and_files(tmp_path):
     processes = {}
     for name in NAMES:
         command = [sys.executable, str(SCRIPTS / f"{name}.py"), "--order", str(min(SMALL_ORDER[name], 2)), "--output", str(tmp_path / name)]
-        processes[name] = subprocess.Popen(command, cwd=REPOSITORY, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        processes[name] = subprocess.Popen(command, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     failing = subprocess.Popen(
         [sys.executable, str(SCRIPTS / "grazing.py"), "--order", "0", "--output", str(tmp_path / "bad")],
-        cwd=REPOSITORY, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
     for name, process in processes.items():
         stdout, stderr = process.communicate(timeout=120)
         assert process.returncode == 0, (name, stderr)
         expected = [tmp_path / name / f"{name}.tex", tmp_path / name / f"{name}.json"]
-        assert [Path(line) for line in stdout.split()] == expected
+        assert [Path(line.split("wrote ", 1)[1]) for line in stdout.splitlines() if line.startswith("  wrote ")] == expected
+        assert stdout.startswith(f"{name} (order ") and "omega = " in stdout
+        assert "DISAGREES" not in stdout and "agrees" in stdout
         assert "omega" in json.loads(expected[1].read_text(encoding="utf-8"))
         assert_valid_latex(expected[0].read_text(encoding="utf-8"))
     _, stderr = failing.communicate(timeout=120)
     assert failing.returncode == 2 and stderr.startswith("error:") and not (tmp_path / "bad").exists()
 
 
-def test_every_registered_name_has_a_script_and_no_script_is_unregistered():
-    scripts = {path.stem for path in SCRIPTS.glob("*.py")}
+def test_every_case_has_a_script_and_no_script_is_unlisted():
+    scripts = {path.stem for path in SCRIPTS.glob("*.py") if not path.name.startswith("_")}
     assert scripts == set(NAMES)
     assert "output/" in (SCRIPTS / ".gitignore").read_text(encoding="utf-8").split()
 
 
 def test_cli_derive_list_and_run(tmp_path, capsys):
-    from lindstedt._cli import main
-
     assert main(["derive", "--list"]) == 0
-    assert "duffing" in capsys.readouterr().out
+    listed = capsys.readouterr().out.splitlines()
+    assert [line.split()[0] for line in listed] == sorted(NAMES)
+    assert listed == [f"{name:18s} {description}" for name, description in common.list_derivations()]
     assert main(["derive", "u_plus", "--order", "2", "--format", "json", "--output", str(tmp_path)]) == 0
     assert '"omega"' in capsys.readouterr().out
     assert (tmp_path / "u_plus.tex").exists() and (tmp_path / "u_plus.json").exists()
+    assert main(["derive", "gap", "--order", "1", "--format", "latex", "--output", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("% lindstedt derive gap --order 1") and "\\subsection*" in out
+    assert (tmp_path / "out" / "gap.tex").read_text(encoding="utf-8") == out
     assert main(["derive", "no_such_case"]) == 2
     assert "unknown derivation" in capsys.readouterr().err
+    assert main(["derive", "nnm_2dof", "--order", "13"]) == 2
+    assert "order" in capsys.readouterr().err
+
+
+def test_cli_derive_without_the_source_tree_names_it(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(lindstedt, "__file__", str(tmp_path / "site-packages" / "lindstedt" / "__init__.py"))
+    assert main(["derive", "--list"]) == 2
+    assert "source tree" in capsys.readouterr().err

@@ -4,7 +4,7 @@ import pytest
 import sympy
 
 import lindstedt
-from lindstedt._reference_duffing import duffing_frequency_taylor
+from lindstedt.references import duffing_frequency_taylor
 
 ORDER = 10
 

@@ -7,7 +7,7 @@ import pytest
 import sympy
 
 import lindstedt
-from lindstedt._cli import main
+from lindstedt.cli import main
 
 
 def test_json_schema_and_round_trip_of_exact_values():

@@ -1,6 +1,6 @@
 """Exact flow of M X'' + K X + ε W (A X − b)_+ = 0 against independent references.
 
-Every expected value is computed here, independently of lindstedt._flow: closed
+Every expected value is computed here, independently of lindstedt.numerics.ExactFlow: closed
 forms derived by hand for one degree of freedom, a modal closed form of the
 free (linear) flight built with numpy, and scipy's DOP853 on a right-hand side
 written in this file.
@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 
+import mpmath
 import numpy as np
 import pytest
 import scipy.linalg
@@ -20,9 +21,8 @@ from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from lindstedt._errors import ProblemError
-from lindstedt._flow import ExactFlow, smooth_flow
-from lindstedt._system import OneDofUnilateral, UnilateralSystem
+from lindstedt import ProblemError, UnilateralSystem
+from lindstedt.numerics import ExactFlow, smooth_flow
 
 
 # --------------------------------------------------------------------------- #
@@ -106,7 +106,7 @@ def test_one_dof_matches_hand_derived_closed_form(omega0, a, b, eps, U):
     reference = OneDofPiecewise(omega0, a, b, eps, U)
     n_periods = 300
     t_end = n_periods * reference.period
-    result = ExactFlow(OneDofUnilateral(omega0, a, b), eps).solve([-U], [0.0], t_end)
+    result = ExactFlow(UnilateralSystem.one_dof(omega0, a, b), eps).solve([-U], [0.0], t_end)
     assert result.success, result.message
     enter = np.array([e.time for e in result.events if e.direction == 1])
     leave = np.array([e.time for e in result.events if e.direction == -1])
@@ -124,7 +124,7 @@ def test_one_dof_paper_frequency():
     # u'' + ω0² u + ε u_+ = 0: P(ε) = (1 + (1 + ε/ω0²)^(-1/2)) π/ω0 (seed paper, section 2)
     omega0, eps = 1.4, 0.9
     period = (1 + (1 + eps / omega0**2) ** -0.5) * math.pi / omega0
-    result = ExactFlow(OneDofUnilateral(omega0), eps).solve([0.8], [0.0], 50 * period)
+    result = ExactFlow(UnilateralSystem.one_dof(omega0), eps).solve([0.8], [0.0], 50 * period)
     position, velocity = result.state(period * np.arange(51))
     np.testing.assert_allclose(position[:, 0], 0.8, rtol=0, atol=1e-13)
     np.testing.assert_allclose(velocity[:, 0], 0.0, rtol=0, atol=1e-13)
@@ -132,7 +132,7 @@ def test_one_dof_paper_frequency():
 
 def test_switch_exactly_at_time_zero_uses_the_direction_of_motion():
     omega0, eps, gap = 1.0, 3.0, 0.5
-    flow = ExactFlow(OneDofUnilateral(omega0, 1, gap), eps)
+    flow = ExactFlow(UnilateralSystem.one_dof(omega0, 1, gap), eps)
     Omega, u_c = 2.0, eps * gap / 4.0
     # entering: in contact first, u = u_c + (gap − u_c) cos Ωt + (v/Ω) sin Ωt
     entering = flow.solve([gap], [0.3], 0.5)
@@ -154,7 +154,7 @@ def test_switch_exactly_at_time_zero_uses_the_direction_of_motion():
 def test_grazing_exactly_at_the_maximum_one_dof():
     # u = g sin t touches the gap g exactly at its maxima: no switch, ever
     for gap in (1.0, 0.3, 1 / 3, 0.7):
-        result = ExactFlow(OneDofUnilateral(1.0, 1, gap), 2.0).solve([0.0], [gap], 200 * np.pi)
+        result = ExactFlow(UnilateralSystem.one_dof(1.0, 1, gap), 2.0).solve([0.0], [gap], 200 * np.pi)
         assert result.n_switches == 0 and result.contact_states == ((),)
         t = np.linspace(0, 200 * np.pi, 20_001)
         np.testing.assert_allclose(result.state(t)[0][:, 0], gap * np.sin(t), rtol=0, atol=1e-13)
@@ -172,7 +172,7 @@ def test_near_double_crossing_one_dof_is_found():
     assert t_out - t_in < 1e-4
     coarse = np.linspace(0, 3, 3 * 64 + 1)  # a sampler with 64 points per unit time misses it
     assert np.all(U * np.sin(coarse) - gap < 0)
-    result = ExactFlow(OneDofUnilateral(omega0, 1, gap), eps).solve([0.0], [U], 3.0)
+    result = ExactFlow(UnilateralSystem.one_dof(omega0, 1, gap), eps).solve([0.0], [U], 3.0)
     assert [(e.direction, e.spring) for e in result.events] == [(1, 0), (-1, 0)]
     # root conditioning: |g'| ≈ √(2d) so times are good to ~eps/√(2d)
     assert result.events[0].time == pytest.approx(t_in, abs=1e-10)
@@ -332,22 +332,43 @@ def test_simultaneous_switches_of_symmetric_springs():
     np.testing.assert_allclose(switches[2::2] - switches[1:-1:2], duration, rtol=1e-12)
 
 
-@pytest.mark.skipif(np.finfo(np.longdouble).eps >= np.finfo(float).eps, reason="no extended precision here")
-def test_modal_refinement_reaches_extended_precision():
-    from lindstedt._flow import _refine_symmetric
+def free_flight_reference(M, K, x0, v0, t, dps=40):
+    """X(t) of M X'' + K X = 0 in mpmath: y = Lᵀ X (M = L Lᵀ) obeys y'' + L⁻¹ K L⁻ᵀ y = 0, solved by eigsy."""
+    n = len(x0)
+    with mpmath.workdps(dps):
+        lower = mpmath.cholesky(mpmath.matrix(np.asarray(M).tolist()))
+        inverse = mpmath.inverse(lower)
+        symmetric = inverse * mpmath.matrix(np.asarray(K).tolist()) * inverse.T
+        values, vectors = mpmath.eigsy((symmetric + symmetric.T) / 2)
+        q0 = vectors.T * (lower.T * mpmath.matrix(list(x0)))
+        p0 = vectors.T * (lower.T * mpmath.matrix(list(v0)))
+        q = mpmath.matrix(n, 1)
+        for k in range(n):
+            omega = mpmath.sqrt(values[k])
+            q[k] = q0[k] * mpmath.cos(omega * t) + p0[k] / omega * mpmath.sin(omega * t)
+        x = inverse.T * (vectors * q)
+        return np.array([float(x[i]) for i in range(n)])
 
+
+@pytest.mark.skipif(np.finfo(np.longdouble).eps >= np.finfo(float).eps, reason="no extended precision here")
+def test_clustered_modes_reach_extended_precision():
+    # a double and a near-double eigenvalue: with double-precision eigenvectors alone the free flight is off by
+    # ~1e-14 at t = 1000; the extended-precision modal refinement keeps it within rounding of the exact solution
     rng = np.random.default_rng(7)
     B = rng.normal(size=(5, 5))
     M = B @ B.T + 5 * np.eye(5)
     Q, _ = np.linalg.qr(rng.normal(size=(5, 5)))
-    K = Q @ np.diag([1.0, 1.0, 2.0, 3.0, 3.0 + 1e-12]) @ Q.T  # a double and a near-double eigenvalue
+    K = Q @ np.diag([1.0, 1.0, 2.0, 3.0, 3.0 + 1e-12]) @ Q.T
     K = (K + K.T) / 2
-    _, basis = scipy.linalg.eigh(K, M)
-    values, X = _refine_symmetric(K.astype(np.longdouble), M.astype(np.longdouble), basis)
-    residual = np.eye(5, dtype=np.longdouble) - X.T @ M.astype(np.longdouble) @ X
-    rayleigh = X.T @ K.astype(np.longdouble) @ X
-    assert float(np.max(np.abs(residual))) < 1e-17
-    assert float(np.max(np.abs(rayleigh - np.diag(values)))) < 1e-17
+    system = UnilateralSystem(M=M, K=K, A=[[1, 0, 0, 0, 0]], b=[1e6])  # W = Aᵀ; the spring is never reached
+    for seed in range(3):
+        state = np.random.default_rng(seed).normal(size=10)
+        result = ExactFlow(system, 0.5).solve(state[:5], state[5:], 1000.0)
+        assert result.success and result.n_switches == 0 and result.n_arcs > 10
+        times = np.linspace(0.0, 1000.0, 5)
+        for t, position in zip(times, result.state(times)[0]):
+            exact = free_flight_reference(M, K, state[:5], state[5:], t)
+            assert np.max(np.abs(position - exact)) < 4 * np.finfo(float).eps * np.max(np.abs(exact))
 
 
 def test_unstable_contact_state_is_reported():
@@ -438,7 +459,7 @@ def test_bad_flow_construction():
     with pytest.raises(ProblemError, match="needs a UnilateralSystem"):
         ExactFlow({"M": [[1]]}, 1.0)
     with pytest.raises(ProblemError, match="finite"):
-        ExactFlow(OneDofUnilateral(1), float("nan"))
+        ExactFlow(UnilateralSystem.one_dof(1), float("nan"))
 
 
 # --------------------------------------------------------------------------- #
@@ -491,7 +512,7 @@ def test_smooth_flow_duffing_matches_jacobi_elliptic_solution():
 
 def test_smooth_flow_accepts_strings_and_agrees_with_exact_flow_for_the_kink():
     omega0, eps = 1.0, 0.5
-    exact = ExactFlow(OneDofUnilateral(omega0), eps).solve([1.0], [0.0], 30.0)
+    exact = ExactFlow(UnilateralSystem.one_dof(omega0), eps).solve([1.0], [0.0], 30.0)
     fallback = smooth_flow("Max(u, 0)", omega0, eps, 1.0, 0.0, 30.0)
     t = np.linspace(0, 30, 301)
     np.testing.assert_allclose(fallback.state(t)[0], exact.state(t)[0], rtol=0, atol=1e-8)
@@ -501,9 +522,32 @@ def test_smooth_flow_accepts_strings_and_agrees_with_exact_flow_for_the_kink():
         smooth_flow(sympy.sympify("c*u**3"), 1.0, 1.0, 1.0, 0.0, 1.0)
 
 
+@pytest.mark.xfail(
+    strict=True,
+    reason="known defect of ExactFlow: after engaging on a contact excursion 1e-12 to 1e-7 deep (relative) the flow "
+    "often switches in and out at the same instant until max_arcs; excursions 1e-6 deep and deeper are fine",
+)
+def test_shallow_contact_excursion_is_one_engagement_and_one_release():
+    # u'' + u + (u − b)_+ = 0 from rest at u = −1 with b = 1 − 1e-7: free u = −cos t reaches b at t_in = π − arccos b
+    # with u' = sin t_in; in contact u − b/2 = A_c cos(√2 (t − t_peak)) about the equilibrium b/2, symmetric
+    b = 1 - 1e-7
+    t_in = math.pi - math.acos(b)
+    speed = math.sin(t_in)
+    amplitude = math.hypot(b / 2, speed / math.sqrt(2))
+    t_out = t_in + 2 * math.acos((b / 2) / amplitude) / math.sqrt(2)
+    result = ExactFlow(UnilateralSystem.one_dof(1, b=b), 1.0, max_arcs=1000).solve([-1.0], [0.0], 5.0)
+    assert result.success, result.message
+    assert [e.direction for e in result.events] == [1, -1]
+    assert result.events[0].time == pytest.approx(t_in, abs=1e-11)
+    assert result.events[1].time == pytest.approx(t_out, abs=1e-9)
+
+
 # --------------------------------------------------------------------------- #
 # the certified switch search against brute force
 # --------------------------------------------------------------------------- #
+# Free flight of M = I, K = diag(ω_k²) from X(0) = −a, X'(0) = −b ω (k modes) with one spring A = [1 … 1],
+# gap b = offset: the spring's watch function b − A X(t) is h(t) = offset + Σ a_k cos ω_k t + b_k sin ω_k t,
+# and the first switch of ExactFlow is the first zero of h that starts an excursion below the rounding band.
 @settings(max_examples=60, deadline=None)
 @given(
     st.integers(min_value=1, max_value=4).flatmap(
@@ -518,8 +562,6 @@ def test_smooth_flow_accepts_strings_and_agrees_with_exact_flow_for_the_kink():
 )
 def test_switch_search_never_misses_an_excursion(coefficients, which, depth):
     from scipy.optimize import minimize_scalar
-
-    from lindstedt._flow import _Counters, _first_exit
 
     a, b, omega = (np.array(c) for c in coefficients)
     scale = float(np.hypot(a, b).sum())
@@ -542,20 +584,23 @@ def test_switch_search_never_misses_an_excursion(coefficients, which, depth):
     offset = -chosen[1] + depth * scale  # the chosen minimum of h = offset + S sits at depth·scale
     h = lambda t: offset + S(t)  # noqa: E731
     assume(h(0.0) > 1e-3 * scale)  # the search starts on its own side
-    band = 64 * np.finfo(float).eps * scale
+    band = 64 * np.finfo(float).eps * scale  # the flow's band is 64 eps (|offset| + scale), never narrower
     levels = [(t, offset + value) for t, value in minima] + [(T, float(h(T)))]
     # skip an excursion in the grey zone between rounding and a clear crossing
     assume(not any(-1e-11 * scale < level < -0.5 * band for _, level in levels))
     deep = [t for t, level in levels if level <= -1e-11 * scale]
-    counters = _Counters()
-    bracket = _first_exit(offset, a, b, omega, band, T, counters)
+    n = len(omega)
+    system = UnilateralSystem(M=np.eye(n), K=np.diag(omega**2), A=[np.ones(n)], b=[offset])
+    # only the first switch is checked (what follows a shallow contact is test_shallow_contact_excursion_...)
+    result = ExactFlow(system, 1.0, max_arcs=200).solve(-a, -b * omega, T)
     if not deep:
-        assert bracket is None
+        assert result.success and result.n_switches == 0
         return
     first_deep = min(deep)
     before = np.flatnonzero((grid < first_deep) & (h(grid) >= 0))
     expected = brentq(lambda t: float(h(t)), grid[before[-1]], first_deep, xtol=1e-15, rtol=1e-15)
-    assert bracket is not None
-    root = bracket.polish(counters)
-    assert root == pytest.approx(expected, abs=1e-8)
-    assert abs(float(h(root))) <= 1e-13 * scale
+    assert result.n_switches >= 1
+    first = result.events[0]
+    assert first.spring == 0 and first.direction == 1
+    assert first.time == pytest.approx(expected, abs=1e-8)
+    assert abs(float(h(first.time))) <= 1e-13 * scale

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import lindstedt
-from lindstedt._cli import main
+from lindstedt.cli import main
 
 
 @pytest.mark.parametrize("mode", [1, 2, 3])

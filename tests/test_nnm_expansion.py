@@ -8,9 +8,9 @@ from scipy.optimize import root
 
 import lindstedt
 from lindstedt import ProblemError, ResonanceError, UnilateralSystem
-from lindstedt._cli import main
-from lindstedt._nnm_expansion import release_amplitudes_by_series
-from lindstedt._flow import ExactFlow
+from lindstedt.cli import main
+from lindstedt.numerics import ExactFlow
+from lindstedt.references import release_amplitudes_by_series
 
 EPSILONS = np.geomspace(0.0005, 0.004, 8)  # in units of λ_j² (the small parameter is ε/λ_j²)
 #: the a_k are compared to within this many times the reference's own error estimate (propagated + truncation)

@@ -1,8 +1,8 @@
 """NNMs of M X'' + K X + ε W (A X − b)_+ = 0 by shooting, against independent references.
 
-Expected values come from computations independent of lindstedt._nnm_numeric:
+Expected values come from computations independent of the shooting (lindstedt.numerics.nnm_point and friends):
 the closed-form period of the one-dof piecewise-linear oscillator
-(lindstedt._reference_piecewise), the bilinear-oscillator formula
+(lindstedt.references), the bilinear-oscillator formula
 ω = 2 λ ω_c / (λ + ω_c) derived by hand, the first-order averaging coefficient
 ω_1 = φ_jᵀ W A φ_j / (4 λ_j) for gaps b = 0 (derived below), central finite
 differences, and direct flows of ExactFlow (the ground truth the shooting uses,
@@ -17,9 +17,10 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 
-from lindstedt._flow import ExactFlow
-from lindstedt._nnm_numeric import (
+from lindstedt import UnilateralSystem
+from lindstedt.numerics import (
     ContinuationProgress,
+    ExactFlow,
     NNMShooting,
     continue_nnm,
     flow_epsilon_derivative,
@@ -28,8 +29,7 @@ from lindstedt._nnm_numeric import (
     nnm_sweep,
     seed_example_system,
 )
-from lindstedt._reference_piecewise import piecewise_linear_exact_frequency
-from lindstedt._system import UnilateralSystem
+from lindstedt.references import piecewise_linear_exact_frequency
 
 
 # --------------------------------------------------------------------------- #
@@ -101,7 +101,7 @@ def test_one_dof_energy_parametrisation_matches_closed_form():
 
 def test_one_dof_first_taylor_coefficient_from_two_epsilons():
     """ω(ε) = ω0 + ε ω1 + …: Richardson from two ε vs the reference's exact ω1 (gap ≠ 0)."""
-    from lindstedt._reference_piecewise import piecewise_linear_frequency_taylor
+    from lindstedt.references import piecewise_linear_frequency_taylor
 
     omega0, b, a0 = 1.2, 0.3, 1.0
     system = UnilateralSystem.one_dof(omega0, a=1, b=b)

@@ -9,8 +9,8 @@ from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
 import lindstedt
-from lindstedt._contact_fourier import contact_ramp_coefficient
-from lindstedt._reference_piecewise import piecewise_linear_exact_frequency, piecewise_linear_frequency_taylor
+from lindstedt.algebra import contact_ramp_coefficient
+from lindstedt.references import piecewise_linear_exact_frequency, piecewise_linear_frequency_taylor
 
 omega0 = sympy.Symbol("omega0", positive=True)
 

@@ -1,4 +1,4 @@
-"""Tests of the exact truncated power-series arithmetic (lindstedt._power_series).
+"""Tests of the exact truncated power-series arithmetic (lindstedt.algebra.PowerSeries, binomial_series).
 
 Expectations come from closed forms (binomial coefficients, Catalan numbers,
 geometric series) or from sympy's own ``series``, never from the module.
@@ -13,8 +13,8 @@ import sympy
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from lindstedt._errors import OrderError, ProblemError
-from lindstedt._power_series import PowerSeries, binomial_series
+from lindstedt import OrderError, ProblemError
+from lindstedt.algebra import PowerSeries, binomial_series
 
 X = sympy.Symbol("x")
 

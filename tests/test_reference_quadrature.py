@@ -1,4 +1,4 @@
-"""Tests of the quadrature reference (lindstedt._reference_quadrature).
+"""Tests of the quadrature reference (lindstedt.references: conservative_*, frequency_taylor_coefficients).
 
 Equation: u'' + omega0**2 u + epsilon f(u) = 0, u(0) = a0, u'(0) = 0.
 Expectations come from exact closed forms (linear f, the Duffing elliptic
@@ -18,11 +18,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
-from lindstedt._errors import ConvergenceError, OrderError, ParameterError, ProblemError
-from lindstedt._reference_duffing import duffing_frequency_taylor
-from lindstedt._reference_quadrature import (
+from lindstedt import ConvergenceError, OrderError, ParameterError, ProblemError
+from lindstedt.references import (
     conservative_frequency,
     conservative_period,
+    duffing_frequency_taylor,
     frequency_taylor_coefficients,
 )
 

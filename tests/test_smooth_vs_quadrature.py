@@ -5,7 +5,7 @@ import pytest
 import sympy
 
 import lindstedt
-from lindstedt._reference_quadrature import frequency_taylor_coefficients
+from lindstedt.references import frequency_taylor_coefficients
 
 u = sympy.Symbol("u", real=True)
 ORDER = 6

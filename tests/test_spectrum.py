@@ -1,4 +1,4 @@
-"""Fourier spectra (lindstedt._spectrum) against exact line spectra and closed forms.
+"""Fourier spectra (lindstedt.validate.spectrum and friends) against exact line spectra and closed forms.
 
 Expected values: trigonometric polynomials (exact line spectra); the exact
 solution of u'' + ω0² u + ε u_+ = 0 written by hand (contact arc a0 cos(ω' t),
@@ -20,8 +20,8 @@ import pytest
 import scipy.special
 
 import lindstedt
-from lindstedt._errors import ProblemError
-from lindstedt._spectrum import exact_period, exact_spectrum, expansion_spectrum, spectrum
+from lindstedt import ProblemError
+from lindstedt.validate import exact_period, exact_spectrum, expansion_spectrum, spectrum
 
 
 def d_u_plus(k, a0=1.0, omega0=1.0):

@@ -8,7 +8,7 @@ import pytest
 import sympy
 
 import lindstedt
-from lindstedt._reference_duffing import duffing_exact_frequency, duffing_frequency_taylor
+from lindstedt.references import duffing_exact_frequency, duffing_frequency_taylor
 
 
 def test_large_epsilon_is_reported_not_silent():
@@ -36,7 +36,7 @@ def test_high_precision_analytic_f_agrees_between_precisions():
 def test_near_grazing_piecewise_float_path_stays_accurate_at_high_order():
     kappa = sympy.Rational(999999, 1000000)
     expansion = lindstedt.expand(f"Max(0, u - ({kappa}))", order=4, a0=1, omega0=1, numeric=True, precision=20)
-    from lindstedt._reference_piecewise import piecewise_linear_frequency_taylor
+    from lindstedt.references import piecewise_linear_frequency_taylor
 
     with mpmath.workdps(60):
         reference = piecewise_linear_frequency_taylor(4, a=1, b=mpmath.mpf(kappa.p) / kappa.q, a0=1, dps=60)

@@ -12,8 +12,7 @@ import sympy
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from lindstedt._errors import ProblemError
-from lindstedt._system import OneDofUnilateral, UnilateralSystem
+from lindstedt import ProblemError, UnilateralSystem
 
 
 def test_exact_and_float_copies_from_mixed_input():
@@ -123,14 +122,14 @@ def test_chain_matrices_and_unilateral_springs():
 
 
 def test_one_dof_factory():
-    system = OneDofUnilateral("3/2", a=2, b="1/4")
+    system = UnilateralSystem.one_dof("3/2", a=2, b="1/4")
     assert system.K_exact[0, 0] == sympy.Rational(9, 4)
     assert system.W_exact[0, 0] == 1 and not system.symmetric_coupling
-    assert UnilateralSystem.one_dof(1) == OneDofUnilateral(1)
+    assert UnilateralSystem.one_dof(1) == UnilateralSystem(M=[[1]], K=[[1]], A=[[1]], b=[0])
     with pytest.raises(ProblemError, match="omega0 must be positive"):
-        OneDofUnilateral(-1)
+        UnilateralSystem.one_dof(-1)
     with pytest.raises(ProblemError, match="a must be non-zero"):
-        OneDofUnilateral(1, a=0)
+        UnilateralSystem.one_dof(1, a=0)
 
 
 def test_chain_modes_match_the_known_closed_form():
@@ -191,4 +190,4 @@ def test_energy_and_acceleration_formulas():
     batch = system.energy(np.stack([x, x]), np.stack([v, v]), eps)
     np.testing.assert_allclose(batch, [7.25, 7.25], rtol=1e-15)
     with pytest.raises(ProblemError, match="W = Aᵀ"):
-        OneDofUnilateral(1, a=2).energy([1.0], [0.0], 1.0)
+        UnilateralSystem.one_dof(1, a=2).energy([1.0], [0.0], 1.0)

@@ -1,4 +1,4 @@
-"""Validation tools (lindstedt._validation) against independent references and theory.
+"""Validation tools (lindstedt.validate) against independent references and theory.
 
 Expected values come from closed forms derived by hand in this file (the
 piecewise-harmonic motion of u'' + ω0² u + ε a (u − b)_+ = 0, its period at
@@ -26,8 +26,8 @@ import scipy.special
 from scipy.integrate import solve_ivp
 
 import lindstedt
-from lindstedt._errors import ProblemError
-from lindstedt._validation import (
+from lindstedt import ProblemError
+from lindstedt.validate import (
     contact_measure,
     expansion_error,
     fitted_contact_measure_order,

@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 import lindstedt
 from lindstedt import Expansion, ParameterError, ProblemError
-from lindstedt._reference_piecewise import piecewise_linear_exact_frequency
+from lindstedt.references import piecewise_linear_exact_frequency
 
 HALF = sympy.Rational(1, 2)
 

@@ -27,6 +27,7 @@ def main() -> None:
     import sympy
 
     import lindstedt
+    from lindstedt import __version__ as lindstedt_version
 
     import_seconds = time.perf_counter() - start
 
@@ -44,7 +45,7 @@ def main() -> None:
 
     result = {
         "tool": "lindstedt",
-        "version": lindstedt.__version__,
+        "version": lindstedt_version,
         "sympy": sympy.__version__,
         "order": order,
         "mode": mode,

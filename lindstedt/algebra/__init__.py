@@ -1,0 +1,87 @@
+"""Exact algebra behind the expansions: cosine series, the contact Fourier kernel, power series.
+
+Cosine series (2π-periodic, even)
+    :class:`CosineSeries` ``v(s) = Σ_n c_n cos(n s)`` and :class:`SineSeries`
+    ``Σ_n c_n sin(n s)``, with coefficients in a sympy domain (``QQ``,
+    ``QQ[r1, …]``, ``RealField``), multiplied by
+    ``cos(m s) cos(n s) = ½ [cos((m + n) s) + cos(|m − n| s)]``;
+    :func:`solve_harmonic_oscillator` solves ``α0 (v'' + v) = r(s)`` in closed form,
+    ``v = Σ_{n≠1} r_n / (α0 (1 − n²)) cos(n s) + C cos(s)``, and raises
+    :class:`SecularTermError` when ``r`` still has a ``cos(s)`` term.
+
+Contact Fourier kernel of a unilateral spring (``κ = b/|a0|``, ``β = arccos κ``)
+    ``(cos s − κ)_+ = Σ_k c_k[κ] cos(k s)`` and ``H(cos s − κ) = Σ_k h_k[κ] cos(k s)``
+    with ``c_0 = (sin β − κ β)/π``, ``c_1 = (β − κ sin β)/π``,
+    ``c_k = 2 (κ sin kβ − k sin β cos kβ) / (π k (k² − 1))`` (k ≥ 2),
+    ``h_0 = β/π``, ``h_k = 2 sin(kβ)/(π k)``:
+    exactly (:func:`contact_angle`, :func:`contact_ramp_coefficient`,
+    :func:`contact_step_coefficient`, and the coefficients of their products with
+    ``cos(m s)``: :func:`ramp_times_cosine_coefficient`,
+    :func:`step_times_cosine_coefficient`), in floating point accurate near
+    grazing ``κ → ±1`` and for ``k`` up to ~1e6 (:func:`contact_angle_float`,
+    :func:`contact_ramp_coefficients_float`, :func:`contact_step_coefficients_float`),
+    at any mpmath precision (:func:`contact_ramp_coefficient_mp`,
+    :func:`contact_step_coefficient_mp`), and the accelerated sums of the slowly
+    converging series they build (:func:`series_sum`,
+    :func:`sum_cosine_series_at`, each a :class:`SeriesEstimate` ``(value, error_estimate)``).
+
+Truncated power series over the rationals
+    :class:`PowerSeries` ``c_0 + c_1 x + … + c_n x^n + O(x^{n+1})``: exact sums,
+    products, reciprocal, composition, reversion and rational powers;
+    :func:`binomial_series` ``(1 + x)^p``.
+
+Examples
+--------
+>>> import sympy
+>>> from sympy import QQ
+>>> from lindstedt.algebra import CosineSeries, PowerSeries, contact_ramp_coefficient, solve_harmonic_oscillator
+>>> s = sympy.Symbol("s")
+>>> (CosineSeries.cosine(QQ) ** 3).to_expr(s)             # cos³ s = (3 cos s + cos 3s)/4
+3*cos(s)/4 + cos(3*s)/4
+>>> solve_harmonic_oscillator(CosineSeries.cosine(QQ, 3), QQ(1), value_at_zero=QQ(0)).to_expr(s)
+cos(s)/8 - cos(3*s)/8
+>>> contact_ramp_coefficient(2, 0)                        # c_2[0] = 2/(3π)
+2/(3*pi)
+>>> [str(c) for c in PowerSeries([1, 1], order=3).power(sympy.Rational(1, 2)).coefficients]   # √(1 + x)
+['1', '1/2', '-1/8', '1/16']
+"""
+
+from .._contact_fourier import (
+    SeriesEstimate,
+    contact_angle,
+    contact_angle_float,
+    contact_ramp_coefficient,
+    contact_ramp_coefficient_mp,
+    contact_ramp_coefficients_float,
+    contact_step_coefficient,
+    contact_step_coefficient_mp,
+    contact_step_coefficients_float,
+    ramp_times_cosine_coefficient,
+    series_sum,
+    step_times_cosine_coefficient,
+    sum_cosine_series_at,
+)
+from .._cosine import CosineSeries, SecularTermError, SineSeries, solve_harmonic_oscillator
+from .._power_series import PowerSeries, binomial_series
+
+__all__ = [
+    "CosineSeries",
+    "SineSeries",
+    "solve_harmonic_oscillator",
+    "SecularTermError",
+    "contact_angle",
+    "contact_angle_float",
+    "contact_ramp_coefficient",
+    "contact_step_coefficient",
+    "ramp_times_cosine_coefficient",
+    "step_times_cosine_coefficient",
+    "contact_ramp_coefficients_float",
+    "contact_step_coefficients_float",
+    "contact_ramp_coefficient_mp",
+    "contact_step_coefficient_mp",
+    "SeriesEstimate",
+    "series_sum",
+    "sum_cosine_series_at",
+    "PowerSeries",
+    "binomial_series",
+]

@@ -1,0 +1,73 @@
+"""Independent exact references: frequencies computed without any Lindstedt–Poincaré machinery.
+
+Each reference solves the problem it names by a route of its own, so that it can
+check the expansions of :func:`lindstedt.expand` and :func:`lindstedt.nnm`:
+
+Duffing oscillator ``u'' + ω0² u + ε c u³ = 0``, ``u(0) = A``, ``u'(0) = 0``
+    :func:`duffing_exact_frequency` — ``ω = π Ω / (2 K(m))`` (complete elliptic
+    integral K, ``Ω = ω0 √(1 + x)``, ``m = x / (2 (1 + x))``, ``x = ε c A² / ω0²``);
+    :func:`duffing_frequency_taylor` — the exact rational Taylor coefficients
+    ``r_k`` of ``ω = ω0 Σ r_k x^k`` (release point or first-harmonic amplitude).
+
+Unilateral spring ``u'' + ω0² u + ε a (u − b)_+ = 0``, ``u(0) = a0``, ``u'(0) = 0``
+    :func:`piecewise_linear_exact_period`, :func:`piecewise_linear_exact_frequency`
+    — the closed-form period ``T = 2 (π − arccos w_f)/ω0 + 2 arccos(w_c)/Ω``,
+    ``Ω² = ω0² + ε a`` (the orbit is a free and a contact ellipse joined at
+    ``u = b``); :func:`piecewise_linear_frequency_taylor` — the Taylor
+    coefficients ``ω_k`` of ``ω(ε) = Σ ω_k ε^k`` by a Cauchy integral of that
+    closed form, each with an error estimate; :func:`piecewise_linear_frequency_taylor_symbolic`
+    — for ``b = 0`` (``T = π/ω0 + π/Ω``) the exact Taylor polynomial in ε.
+
+Smooth conservative oscillator ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0``, ``u'(0) = 0``
+    :func:`conservative_period`, :func:`conservative_frequency` — the period
+    ``T = 2 |∫_b^a0 du / √(2 (V(a0) − V(u)))|``, ``V = ω0² u²/2 + ε F(u)``, by
+    quadrature, with an error estimate; :func:`frequency_taylor_coefficients` —
+    the ``ω_k`` from a Chebyshev interpolant of ``ω(ε) = 2π/T``;
+    :func:`as_mpmath_number` — how these references read a number (exact
+    inputs rounded once, at the mpmath precision in effect).
+
+Nonlinear normal modes of ``M X'' + K X + ε W (A X − b)_+ = 0``
+    :func:`release_amplitudes_by_series` — the release amplitudes ``a_k``
+    (k ≠ j) of mode j at first order as Fourier series of the contact functions,
+    summed with an error estimate (a cross-check of :func:`lindstedt.nnm`'s closed form).
+
+Examples
+--------
+>>> import lindstedt
+>>> from lindstedt.references import duffing_frequency_taylor, piecewise_linear_frequency_taylor_symbolic
+>>> duffing_frequency_taylor(2)
+[1, 3/8, -21/256]
+>>> lindstedt.expand("u**3", order=2, a0=1, omega0=1).omega == tuple(duffing_frequency_taylor(2))
+True
+>>> piecewise_linear_frequency_taylor_symbolic(1)
+a*epsilon/(4*omega0) + omega0
+"""
+
+from .._nnm_expansion import release_amplitudes_by_series
+from .._reference_duffing import duffing_exact_frequency, duffing_frequency_taylor
+from .._reference_piecewise import (
+    piecewise_linear_exact_frequency,
+    piecewise_linear_exact_period,
+    piecewise_linear_frequency_taylor,
+    piecewise_linear_frequency_taylor_symbolic,
+)
+from .._reference_quadrature import (
+    as_mpmath_number,
+    conservative_frequency,
+    conservative_period,
+    frequency_taylor_coefficients,
+)
+
+__all__ = [
+    "duffing_exact_frequency",
+    "duffing_frequency_taylor",
+    "piecewise_linear_exact_period",
+    "piecewise_linear_exact_frequency",
+    "piecewise_linear_frequency_taylor",
+    "piecewise_linear_frequency_taylor_symbolic",
+    "conservative_period",
+    "conservative_frequency",
+    "frequency_taylor_coefficients",
+    "as_mpmath_number",
+    "release_amplitudes_by_series",
+]

@@ -1,0 +1,93 @@
+"""Validation tools: expansions of ``u'' + ω0² u + ε f(u) = 0`` against the true solution.
+
+The problem is ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0 + ε a1``, ``u'(0) = 0``,
+and ``u_N(t) = Σ_{k≤N} ε^k v_k(ω t)`` is its order-N Lindstedt–Poincaré expansion
+(:func:`lindstedt.expand`).
+
+True solution
+    :func:`reference_solution` (a :class:`ReferenceSolution`): the closed-form
+    arcs of the exact piecewise-linear flow for unilateral springs
+    ``a (u − b)_+`` (machine precision), DOP853 for smooth f.
+
+Errors and rates
+    :func:`expansion_error` (:class:`ExpansionError`): ``e(t) = u_N(t) − u(t)``
+    and its phase-plane size ``ρ = ((u_N − u)² + ((u_N' − u')/ω0)²)^{1/2}``;
+    :func:`fitted_convergence_order` (:class:`ConvergenceFit`): the slope of
+    ``log max_{[0, C/ε]} |e|`` against ``log ε`` (N + 1 for a simple contact);
+    :func:`fitted_validity_exponent` (:class:`ValidityFit`): the exponent of
+    the first time ``T_ε`` at which ``ρ > C ε^{N+1}`` (−1; −1/2 at grazing);
+    :func:`loglog_fit` (:class:`LogLogFit`): the least-squares line through
+    ``(log x, log y)`` behind these fits.
+
+Contact measure (Lemma 3.2)
+    :func:`contact_measure` (:class:`ContactMeasure`):
+    ``μ_ε(T) = |{t ∈ [0, T] : |u(t) − b| ≤ ε M}|``;
+    :func:`fitted_contact_measure_order` (:class:`ContactMeasureFit`): the
+    slope of ``log(μ_ε(T)/T)`` against ``log ε`` (1, or 1/2 at grazing).
+
+Spectra (also exported by :mod:`lindstedt`)
+    :func:`spectrum` (:class:`Spectrum` of :class:`SpectralPeak` lines): the
+    line spectrum ``|c_0|, |c_k − i s_k|`` of a periodic signal sampled over
+    whole periods; :func:`expansion_spectrum` samples ``u_N`` over periods of
+    its own ω(ε), :func:`exact_spectrum` the true solution over its exact
+    period :func:`exact_period` (:class:`ExactPeriod`).
+
+Plots
+    :func:`line_plot_svg`: a dependency-free SVG line plot (error curves of
+    ``lindstedt demo`` and of the benchmarks).
+
+Examples
+--------
+>>> import lindstedt
+>>> from lindstedt.validate import expansion_error, loglog_fit
+>>> e = lindstedt.expand("Max(0, u)", order=1, a0=1, omega0=1)
+>>> result = expansion_error(e, 0.01, 100.0)
+>>> result.success, result.reference_method, result.max_error < 2e-4
+(True, 'exact', True)
+>>> round(loglog_fit([0.1, 0.01], [3e-2, 3e-4]).slope, 12)
+2.0
+"""
+
+from .._spectrum import ExactPeriod, SpectralPeak, Spectrum, exact_period, exact_spectrum, expansion_spectrum, spectrum
+from .._svg import line_plot_svg
+from .._validation import (
+    ContactMeasure,
+    ContactMeasureFit,
+    ConvergenceFit,
+    ExpansionError,
+    LogLogFit,
+    ReferenceSolution,
+    ValidityFit,
+    contact_measure,
+    expansion_error,
+    fitted_contact_measure_order,
+    fitted_convergence_order,
+    fitted_validity_exponent,
+    loglog_fit,
+    reference_solution,
+)
+
+__all__ = [
+    "reference_solution",
+    "ReferenceSolution",
+    "expansion_error",
+    "ExpansionError",
+    "fitted_convergence_order",
+    "ConvergenceFit",
+    "fitted_validity_exponent",
+    "ValidityFit",
+    "loglog_fit",
+    "LogLogFit",
+    "contact_measure",
+    "ContactMeasure",
+    "fitted_contact_measure_order",
+    "ContactMeasureFit",
+    "spectrum",
+    "Spectrum",
+    "SpectralPeak",
+    "expansion_spectrum",
+    "exact_spectrum",
+    "exact_period",
+    "ExactPeriod",
+    "line_plot_svg",
+]
