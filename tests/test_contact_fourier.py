@@ -1,4 +1,4 @@
-"""Tests of lindstedt._contact_fourier: Fourier coefficients of (cos s - kappa)_+ and H(cos s - kappa).
+"""Tests of the closed-form Fourier kernel (lindstedt.algebra): Fourier coefficients of (cos s - kappa)_+ and H(cos s - kappa).
 
 Every expectation comes from an independent computation: mpmath quadrature of the
 defining integrals, sympy's own ``integrate``/``summation``, or a straightforward
@@ -7,7 +7,6 @@ closed form evaluated with 120+ digits in the test itself.
 
 from __future__ import annotations
 
-import doctest
 from fractions import Fraction
 
 import mpmath
@@ -15,8 +14,7 @@ import numpy as np
 import pytest
 import sympy
 
-import lindstedt._contact_fourier as contact_fourier
-from lindstedt._contact_fourier import (
+from lindstedt.algebra import (
     SeriesEstimate,
     contact_angle,
     contact_angle_float,
@@ -31,7 +29,7 @@ from lindstedt._contact_fourier import (
     step_times_cosine_coefficient,
     sum_cosine_series_at,
 )
-from lindstedt._errors import ConvergenceError, ProblemError
+from lindstedt import ConvergenceError, ProblemError
 
 s = sympy.Symbol("s", real=True)
 KAPPA = sympy.Symbol("kappa", real=True)
@@ -452,12 +450,6 @@ def test_divergent_series_raises_convergence_error() -> None:
 def test_series_sum_rejects_bad_options(kwargs: dict) -> None:
     with pytest.raises(ProblemError):
         series_sum(lambda n: mpmath.mpf(1) / (n + 1) ** 2, **kwargs)
-
-
-def test_module_examples_run() -> None:
-    failures, attempted = doctest.testmod(contact_fourier, optionflags=doctest.ELLIPSIS)
-    assert attempted > 10
-    assert failures == 0
 
 
 def test_finite_cosine_series_terminates() -> None:
