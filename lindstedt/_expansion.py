@@ -315,24 +315,20 @@ class Expansion:
     @property
     def regime(self) -> str:
         """``"smooth"``, or for piecewise f: ``"contact"``, ``"no contact"`` or ``"grazing"``."""
-        return self._hierarchy.form.regime if self.is_piecewise else "smooth"
+        return self._hierarchy.form.regime
 
     @property
     def validity_exponent(self) -> sympy.Rational:
         """p in the validity time T_ε ~ ε^p: −1 (simple roots of v0 − b), −1/2 (grazing, double root)."""
-        return self._hierarchy.form.validity_exponent if self.is_piecewise else sympy.Integer(-1)
+        return self._hierarchy.form.validity_exponent
 
     @property
     def contact_angles(self) -> tuple[sympy.Expr, ...]:
         """β_i = arccos κ_i of the contact boundaries crossed by v_0 (empty for smooth f)."""
-        if not self.is_piecewise:
-            return ()
         return tuple(boundary.contact_angle for boundary in self._hierarchy.form.boundaries)
 
     def contact_angle_correction(self, order: int) -> tuple[sympy.Expr, ...]:
-        """σ_{i,order}: the ε^order coefficient of the moving contact angles s_i*(ε)."""
-        if not self.is_piecewise:
-            return ()
+        """σ_{i,order}: the ε^order coefficient of the moving contact angles s_i*(ε) (empty for smooth f)."""
         return tuple(self._to_expr(value, order, sympy.Integer(1)) for value in self._hierarchy.boundary_shift(order))
 
     # -- exact quantities ---------------------------------------------------------------
@@ -442,7 +438,7 @@ class Expansion:
                 )
             )
         if amplitude.free_symbols:
-            sign = self._hierarchy.form.amplitude_sign if self.is_piecewise else None
+            sign = self._hierarchy.form.amplitude_sign
             if sign is not None and not amplitude.is_Symbol:
                 relation = ">" if sign > 0 else "<"
                 assumptions.append(

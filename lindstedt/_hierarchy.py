@@ -41,7 +41,7 @@ import math
 import threading
 from collections import OrderedDict
 from dataclasses import dataclass
-from typing import Any, Callable, Hashable, NamedTuple
+from typing import Any, Callable, ClassVar, Hashable, NamedTuple
 
 import mpmath
 import sympy
@@ -93,6 +93,11 @@ class NormalForm:
     taylor_series: Callable[[int], CosineSeries | None]
     prune_tolerance: float | None
     degree: int | None
+    # What a result reads of every normal form (the piecewise one has contact boundaries instead):
+    regime: ClassVar[str] = "smooth"
+    validity_exponent: ClassVar[sympy.Integer] = sympy.Integer(-1)
+    boundaries: ClassVar[tuple] = ()
+    amplitude_sign: ClassVar[int | None] = None  # no side of the release point is assumed
 
     def to_expr(self, element: Any) -> sympy.Expr:
         """Domain element -> sympy expression with the generators substituted."""
@@ -282,6 +287,10 @@ class SmoothHierarchy:
         self.counters = {"products": 0, "secular_projections": 0}
 
     # -- pieces ---------------------------------------------------------------------------
+    def boundary_shift(self, order: int) -> tuple:
+        """No contact boundaries move: smooth f has none."""
+        return ()
+
     def _prune(self, series: CosineSeries) -> CosineSeries:
         if self.form.prune_tolerance is None:
             return series
