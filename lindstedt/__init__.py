@@ -7,7 +7,7 @@ The public API is re-exported here and in the documented public subpackages:
 * :mod:`lindstedt.validate` — expansions against the true solution (errors,
   convergence orders, validity times, contact measure, spectra);
 * :mod:`lindstedt.algebra` — the exact algebra (cosine series, the contact Fourier
-  kernel of ``(cos s − κ)_+`` and ``H(cos s − κ)``, truncated power series);
+  kernel of ``(cos s − κ)_+`` and ``H(cos s − κ)``);
 * :mod:`lindstedt.numerics` — the exact piecewise-linear flow and NNMs by shooting;
 * :mod:`lindstedt.cli` — the ``lindstedt`` command (``python -m lindstedt``).
 
@@ -36,17 +36,20 @@ from ._errors import (
 from ._expansion import Expansion, ExpansionValidityWarning, PiecewiseWaveform, Waveform
 from ._flow import ExactFlow
 from ._hierarchy import LindstedtPoincare
-from ._nnm_expansion import NNMExpansion, StrainedCoordinatesNNM, nnm
-from ._nnm_numeric import NNMBranch, NNMResult, continue_nnm, nnm_point, nnm_sweep, seed_example_system
+from ._nnm_expansion import NNMExpansion, NNMProblem, StrainedCoordinatesNNM, nnm
+from .numerics import NNMBranch, NNMResult, continue_nnm, nnm_point, nnm_sweep, seed_example_system
 from ._problem import Oscillator
-from ._spectrum import Spectrum, exact_spectrum, expansion_spectrum, spectrum
 from ._system import Modes, UnilateralSystem
-from ._validation import (
+from .validate import (
+    Spectrum,
     contact_measure,
+    exact_spectrum,
     expansion_error,
+    expansion_spectrum,
     fitted_convergence_order,
     fitted_validity_exponent,
     reference_solution,
+    spectrum,
 )
 
 __version__ = "0.1.0"
@@ -62,6 +65,7 @@ __all__ = [
     "UnilateralSystem",
     "Modes",
     "StrainedCoordinatesNNM",
+    "NNMProblem",
     "NNMExpansion",
     "ExactFlow",
     "nnm_point",

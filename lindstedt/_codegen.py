@@ -284,7 +284,7 @@ def _nnm_code(result: Any, quantity: str, language: str) -> GeneratedCode:
         )
     if language not in _LANGUAGES:
         raise ProblemError(f"language must be one of {_LANGUAGES}")
-    digits = result._hierarchy.digits
+    digits = result.digits
     expression = sympy.Add(*[sympy.Float(str(value), digits) * EPSILON**n for n, value in enumerate(result.omega)])
     return _generated(language, quantity, [EPSILON], EPSILON, _horner_form(expression, EPSILON))
 

@@ -52,7 +52,7 @@ from ._parsing import parse_real
 from ._series_algebra import LazyOrders, shift_powers
 from ._system import UnilateralSystem
 
-__all__ = ["NNMExpansion", "StrainedCoordinatesNNM", "nnm", "release_amplitudes_by_series"]
+__all__ = ["NNMExpansion", "NNMProblem", "StrainedCoordinatesNNM", "nnm", "release_amplitudes_by_series"]
 
 _RESONANCE_TOLERANCE = 1e-9
 _GRAZING_TOLERANCE = 1e-12
@@ -409,18 +409,58 @@ def _to_float(value: Any) -> float:
 
 
 @dataclass(frozen=True)
+class NNMProblem:
+    """The NNM grown from linear mode j of ``M X'' + K X + ε W (A X − b)_+ = 0``, released at rest.
+
+    Release: modal coordinate u_j(0) = a0 + ε a1 of mode j; the other modal
+    coordinates are what the NNM makes them (u_k(0) = ε a_k + …), X'(0) = 0.
+
+    Parameters
+    ----------
+    system : UnilateralSystem
+    mode : int
+        1-based mode number j (modes by increasing λ).
+    a0, a1 : number or numeric string
+        Exact numbers (a float is its binary value; strings are read by the one parser); a0 ≠ 0.
+
+    Examples
+    --------
+    >>> import lindstedt
+    >>> problem = lindstedt.NNMProblem(lindstedt.UnilateralSystem.chain(2, unilateral=[(0, 0)]), mode=1, a0="1/2")
+    >>> problem.a0, problem.a1
+    (1/2, 0)
+    """
+
+    system: UnilateralSystem
+    mode: int
+    a0: Any
+    a1: Any = 0
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.system, UnilateralSystem):
+            raise ProblemError("system must be a UnilateralSystem (see UnilateralSystem.from_json_dict)")
+        if isinstance(self.mode, bool) or not isinstance(self.mode, int) or not 1 <= self.mode <= self.system.n_dof:
+            raise ProblemError(f"mode must be an integer between 1 and {self.system.n_dof}, got {self.mode!r}")
+        amplitude = parse_real(self.a0, what="a0")
+        if amplitude == 0:
+            raise ProblemError("a0 = 0 is the rest state: give a nonzero modal amplitude a0")
+        object.__setattr__(self, "a0", amplitude)
+        object.__setattr__(self, "a1", parse_real(self.a1, what="a1"))
+
+
+@dataclass(frozen=True)
 class NNMExpansion:
     """Strained-coordinates NNM of mode j to order 2 (and beyond), in physical units.
 
     Attributes
     ----------
-    system : UnilateralSystem
-    mode : int
-        1-based mode number j (modes sorted by increasing λ; shapes signed so that
-        their largest entry — the first such — is positive).
-    a0, a1 : float
-        Release u_j(0) = a0 + ε a1 (modal coordinate of mode j).
+    problem : NNMProblem
+        The system, the mode j (1-based; modes sorted by increasing λ, shapes signed so
+        that their largest entry — the first such — is positive) and the release
+        u_j(0) = a0 + ε a1; ``system``, ``mode``, ``a0``, ``a1`` are read from it.
     order : int
+    digits : int
+        Working decimal digits of the coefficients (precision plus near-resonance guard digits).
     lambdas : tuple of float
         All linear frequencies λ_1 ≤ … ≤ λ_N.
     omega : tuple of mpf
@@ -440,18 +480,15 @@ class NNMExpansion:
     Examples
     --------
     >>> import lindstedt
-    >>> from lindstedt._system import UnilateralSystem
-    >>> system = UnilateralSystem.one_dof(1, a=1, b=0)
+    >>> system = lindstedt.UnilateralSystem.one_dof(1, a=1, b=0)
     >>> result = lindstedt.nnm(system, mode=1, a0=1, order=2)
     >>> [round(float(w), 12) for w in result.omega]
     [1.0, 0.25, -0.125]
     """
 
-    system: UnilateralSystem
-    mode: int
-    a0: float
-    a1: float
+    problem: NNMProblem
     order: int
+    digits: int
     lambdas: tuple[float, ...]
     omega: tuple[Any, ...]
     alpha: tuple[Any, ...]
@@ -460,6 +497,24 @@ class NNMExpansion:
     spring_roots: tuple[str, ...]
     small_divisors: tuple[tuple[int, int, float], ...]
     _hierarchy: _ModalHierarchy = field(repr=False, compare=False)
+
+    @property
+    def system(self) -> UnilateralSystem:
+        return self.problem.system
+
+    @property
+    def mode(self) -> int:
+        return self.problem.mode
+
+    @property
+    def a0(self) -> float:
+        """u_j(0) at ε = 0 (float)."""
+        return float(self.problem.a0)
+
+    @property
+    def a1(self) -> float:
+        """The ε-correction of the release u_j(0) = a0 + ε a1 (float)."""
+        return float(self.problem.a1)
 
     @property
     def a_k(self) -> tuple[Any, ...]:
@@ -532,7 +587,7 @@ class NNMExpansion:
             "order": self.order,
             "lambda": list(self.lambdas),
             "omega": [_to_float(w) for w in self.omega],
-            "omega_digits": [mpmath.nstr(w, self._hierarchy.digits) for w in self.omega],
+            "omega_digits": [mpmath.nstr(w, self.digits) for w in self.omega],
             "alpha": [_to_float(a) for a in self.alpha],
             "a_k": [_to_float(a) for a in self.a_k],
             "validity": {"exponent": str(self.validity_exponent), "spring_roots": list(self.spring_roots)},
@@ -591,19 +646,15 @@ class StrainedCoordinatesNNM:
             raise ProblemError("precision must be an integer number of digits between 15 and 500")
         self.precision = precision
 
-    def expand(self, system: UnilateralSystem, mode: int, a0: Any, order: int = 2, a1: Any = 0) -> NNMExpansion:
-        """NNM of ``mode`` (1-based) released at u_j(0) = a0 + ε a1."""
-        if not isinstance(system, UnilateralSystem):
-            raise ProblemError("system must be a UnilateralSystem (see UnilateralSystem.from_json_dict)")
-        if isinstance(mode, bool) or not isinstance(mode, int) or not 1 <= mode <= system.n_dof:
-            raise ProblemError(f"mode must be an integer between 1 and {system.n_dof}, got {mode!r}")
+    def expand(self, problem: NNMProblem, order: int = 2) -> NNMExpansion:
+        """The NNM of ``problem`` to ``order`` (ω_0 … ω_order, the a_k, the waveform branches)."""
+        if not isinstance(problem, NNMProblem):
+            raise ProblemError("expand takes an NNMProblem(system, mode, a0, a1=0)")
         if isinstance(order, bool) or not isinstance(order, int) or not 0 <= order <= 12:
             raise ProblemError(f"order must be an integer between 0 and 12, got {order!r}")
-        amplitude = parse_real(a0, what="a0")
-        correction = parse_real(a1, what="a1")
-        if amplitude == 0:
-            raise ProblemError("a0 = 0 is the rest state: give a nonzero modal amplitude a0")
-        hierarchy = _ModalHierarchy(system, mode - 1, amplitude, correction, self.precision + _guard_digits(system, mode - 1, order))
+        system, mode = problem.system, problem.mode
+        digits = self.precision + _guard_digits(system, mode - 1, order)
+        hierarchy = _ModalHierarchy(system, mode - 1, problem.a0, problem.a1, digits)
         lam = hierarchy.frequencies[mode - 1]
         scale = 1 / (lam * lam)
         omegas = tuple(hierarchy.frequency(n) * lam * scale**n for n in range(order + 1))
@@ -619,11 +670,9 @@ class StrainedCoordinatesNNM:
             roots.append({"crossing": "simple", "grazing": "double"}.get(spring.status, "none"))
         validity = sympy.Rational(-1, 2) if "double" in roots else sympy.Integer(-1)
         return NNMExpansion(
-            system=system,
-            mode=mode,
-            a0=float(amplitude),
-            a1=float(correction),
+            problem=problem,
             order=order,
+            digits=digits,
             lambdas=tuple(float(value) for value in hierarchy.frequencies),
             omega=omegas,
             alpha=alphas,
@@ -686,10 +735,9 @@ def nnm(system: UnilateralSystem, mode: int, a0: Any, order: int = 2, *, a1: Any
     Examples
     --------
     >>> import lindstedt
-    >>> from lindstedt._system import UnilateralSystem
-    >>> chain = UnilateralSystem.chain(2, unilateral=[(0, 0)])
+    >>> chain = lindstedt.UnilateralSystem.chain(2, unilateral=[(0, 0)])
     >>> result = lindstedt.nnm(chain, mode=1, a0=1)
     >>> len(result.omega), len(result.a_k)
     (3, 1)
     """
-    return StrainedCoordinatesNNM(precision).expand(system, mode, a0, order, a1)
+    return StrainedCoordinatesNNM(precision).expand(NNMProblem(system, mode, a0, a1), order)

@@ -45,25 +45,43 @@ Exact Taylor series.  With ``omega = omega0 sum_k r_k x**k``:
   ``omega/omega0 = (1 - 2m)**(-1/2)/theta3**2`` and the first-harmonic strength
   ``y = x (A1/A)**2 = x / ((1+q)**2 psi**4)``; reverting ``y(q)`` and
   composing gives ``omega/omega0`` as a series in ``y = lam A1**2/omega0**2``.
+
+The series are truncated power series over ``QQ`` in sympy's
+``sympy.polys.ring_series`` (products, reciprocals, roots, composition).  They
+replaced a hand-written power-series class, measured on this very computation
+with identical exact output (CPython 3.11, sympy 1.14, python ground types,
+medians of 5-31 runs in one process, cache cleared; hand-written vs
+ring_series): initial 2.1 vs 2.0 ms at order 10, 72 vs 16 ms at 30, 0.56 vs
+0.11 s at 60, 3.0 vs 0.28 s at 100; harmonic 9.1 vs 8.0 ms, 197 vs 82 ms,
+1.44 vs 0.57 s, 7.6 vs 2.5 s.  ``sympy.series`` of the closed form takes 3.5 s
+at order 10.
 """
 
 from __future__ import annotations
 
 import functools
-from fractions import Fraction
 from typing import Any, Callable
 
 import mpmath
 import sympy
+from sympy import QQ
+from sympy.polys.ring_series import (
+    rs_mul,
+    rs_nth_root,
+    rs_series_from_list,
+    rs_series_inversion,
+    rs_square,
+)
+from sympy.polys.rings import ring
 
 from ._errors import ConvergenceError, OrderError, ProblemError
-from ._power_series import PowerSeries, binomial_series
 from ._reference_quadrature import real_parameter, validate_dps
 
 __all__ = ["duffing_exact_frequency", "duffing_frequency_taylor"]
 
 _NORMALIZATIONS = ("initial", "harmonic")
 _MAXIMUM_TAYLOR_ORDER = 200
+_SERIES_RING, _X = ring("x", QQ)  # truncated series with exact rational coefficients (sympy.polys.ring_series)
 
 
 def _check_normalization(normalization: Any) -> str:
@@ -277,59 +295,84 @@ def _validate_order(order: Any) -> int:
     return order
 
 
-def _hypergeometric_half_half_one(order: int) -> PowerSeries:
-    """2F1(1/2, 1/2; 1; m) = 2K(m)/pi = sum_n (binom(2n, n)/4**n)**2 m**n."""
+def _coefficients(series: Any, order: int) -> tuple[sympy.Rational, ...]:
+    """``c_0, ..., c_order`` of a series in the ring ``QQ[x]`` as sympy Rationals."""
+    return tuple(QQ.to_sympy(series.get((power,), QQ.zero)) for power in range(order + 1))
+
+
+def _hypergeometric_half_half_one(order: int) -> list[Any]:
+    """2F1(1/2, 1/2; 1; m) = 2K(m)/pi = sum_n (binom(2n, n)/4**n)**2 m**n, coefficients to m**order."""
     values = []
-    central = Fraction(1)  # binom(2n, n) / 4**n
+    central = QQ(1)  # binom(2n, n) / 4**n
     for n in range(order + 1):
         if n > 0:
             central = central * (2 * n - 1) / (2 * n)
         values.append(central * central)
-    return PowerSeries(values, order)
+    return values
 
 
 @functools.lru_cache(maxsize=64)
-def _initial_taylor(order: int) -> tuple[Fraction, ...]:
-    x = PowerSeries.variable(order)
-    one_plus_x = x + 1
-    parameter = x * one_plus_x.inverse() / 2  # m(x) = x / (2 (1 + x))
-    complete_integral = _hypergeometric_half_half_one(order).compose(parameter)
-    ratio = binomial_series(Fraction(1, 2), order) * complete_integral.inverse()
-    return tuple(ratio.coefficients)
+def _initial_taylor(order: int) -> tuple[sympy.Rational, ...]:
+    x, precision = _X, order + 1  # ring_series truncates at O(x**precision)
+    parameter = rs_mul(x, rs_series_inversion(1 + x, x, precision), x, precision) * QQ(1, 2)  # m = x/(2(1+x))
+    complete_integral = rs_series_from_list(parameter, _hypergeometric_half_half_one(order), x, precision)
+    ratio = rs_mul(rs_nth_root(1 + x, 2, x, precision), rs_series_inversion(complete_integral, x, precision), x, precision)
+    return _coefficients(ratio, order)
 
 
-def _theta_series(order: int) -> tuple[PowerSeries, PowerSeries]:
-    """theta3(q) = 1 + 2 sum q**(n**2) and psi(q) = sum_{n>=0} q**(n(n+1)) to order."""
-    theta3 = [Fraction(0)] * (order + 1)
-    theta3[0] = Fraction(1)
+def _theta_series(order: int) -> tuple[Any, Any]:
+    """theta3(q) = 1 + 2 sum q**(n**2) and psi(q) = sum_{n>=0} q**(n(n+1)) to q**order."""
+    theta3 = {(0,): QQ(1)}
     n = 1
     while n * n <= order:
-        theta3[n * n] += 2
+        theta3[(n * n,)] = QQ(2)
         n += 1
-    psi = [Fraction(0)] * (order + 1)
+    psi = {}
     n = 0
     while n * (n + 1) <= order:
-        psi[n * (n + 1)] += 1
+        psi[(n * (n + 1),)] = QQ(1)
         n += 1
-    return PowerSeries(theta3, order), PowerSeries(psi, order)
+    return _SERIES_RING(theta3), _SERIES_RING(psi)
+
+
+def _reversion(series: Any, order: int) -> Any:
+    """The compositional inverse ``g`` of ``f = c_1 x + c_2 x**2 + ...`` (``c_1 != 0``) to x**order.
+
+    Lagrange inversion, ``[x**n] g = (1/n) [w**(n-1)] (w/f(w))**n``, on sympy's
+    ring_series products.  Kept instead of ``rs_series_reversion`` because it was
+    measured faster on the Duffing nome series, with the same exact result (CPython
+    3.11, sympy 1.14, python ground types, medians of 3-5 runs): 0.024 s vs 0.091 s
+    at order 30, 0.37 s vs 2.2 s at order 60 (``rs_series_reversion`` recomposes the
+    whole series once per order).
+    """
+    quotient = rs_series_inversion(_SERIES_RING({(power - 1,): value for (power,), value in series.items()}), _X, order)
+    quotient_power = _SERIES_RING.one
+    inverse = {}
+    for n in range(1, order + 1):
+        quotient_power = rs_mul(quotient_power, quotient, _X, order)
+        value = quotient_power.get((n - 1,), QQ.zero)
+        if value:
+            inverse[(n,)] = value / n
+    return _SERIES_RING(inverse)
 
 
 @functools.lru_cache(maxsize=64)
-def _harmonic_taylor(order: int) -> tuple[Fraction, ...]:
+def _harmonic_taylor(order: int) -> tuple[sympy.Rational, ...]:
     if order == 0:
-        return (Fraction(1),)
+        return (sympy.Integer(1),)
+    q, precision = _X, order + 1  # ring_series truncates at O(q**precision)
     theta3, psi = _theta_series(order)
-    nome = PowerSeries.variable(order)
-    theta3_squared_inverse = (theta3 * theta3).inverse()
-    psi_squared = psi * psi
-    parameter = nome * 16 * (psi_squared * theta3_squared_inverse) ** 2  # m(q)
-    one_minus_two_m = 1 - parameter * 2
-    strength = parameter * 2 * one_minus_two_m.inverse()  # x(q) = 2m/(1-2m)
-    frequency_ratio = one_minus_two_m.power(Fraction(-1, 2)) * theta3_squared_inverse
-    amplitude_ratio = ((nome + 1) * psi_squared).inverse()  # A1/A
-    harmonic_strength = strength * amplitude_ratio * amplitude_ratio  # y(q)
-    nome_of_y = harmonic_strength.reversion()
-    return tuple(frequency_ratio.compose(nome_of_y).coefficients)
+    theta3_squared_inverse = rs_series_inversion(rs_square(theta3, q, precision), q, precision)
+    psi_squared = rs_square(psi, q, precision)
+    parameter = rs_mul(q, rs_square(rs_mul(psi_squared, theta3_squared_inverse, q, precision), q, precision), q, precision) * 16  # m(q)
+    one_minus_two_m = 1 - 2 * parameter
+    strength = rs_mul(2 * parameter, rs_series_inversion(one_minus_two_m, q, precision), q, precision)  # x(q) = 2m/(1-2m)
+    frequency_ratio = rs_mul(rs_nth_root(one_minus_two_m, -2, q, precision), theta3_squared_inverse, q, precision)
+    amplitude_ratio = rs_series_inversion(rs_mul(1 + q, psi_squared, q, precision), q, precision)  # A1/A
+    harmonic_strength = rs_mul(strength, rs_square(amplitude_ratio, q, precision), q, precision)  # y(q)
+    nome_of_y = _reversion(harmonic_strength, order)
+    frequency = rs_series_from_list(nome_of_y, list(_coefficients(frequency_ratio, order)), q, precision)
+    return _coefficients(frequency, order)
 
 
 def duffing_frequency_taylor(order: int, normalization: str = "initial") -> list[sympy.Rational]:
@@ -362,5 +405,4 @@ def duffing_frequency_taylor(order: int, normalization: str = "initial") -> list
     """
     order = _validate_order(order)
     normalization = _check_normalization(normalization)
-    fractions_ = _initial_taylor(order) if normalization == "initial" else _harmonic_taylor(order)
-    return [sympy.Rational(value.numerator, value.denominator) for value in fractions_]
+    return list(_initial_taylor(order) if normalization == "initial" else _harmonic_taylor(order))

@@ -201,7 +201,7 @@ def _command_derive(arguments: argparse.Namespace) -> str | tuple[str, int]:
 
 
 def _numeric_nnm(system: Any, arguments: argparse.Namespace) -> tuple[str, int]:
-    from ._nnm_numeric import nnm_point
+    from .numerics import nnm_point
     from ._parsing import parse_float
 
     if arguments.eps is None:

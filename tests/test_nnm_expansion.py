@@ -4,6 +4,7 @@ import json
 
 import numpy as np
 import pytest
+import sympy
 from scipy.optimize import root
 
 import lindstedt
@@ -246,3 +247,17 @@ def test_nnm_waveform_error_is_second_order_over_one_over_epsilon(mode):
         exact, _ = ExactFlow(system, epsilon).solve(expansion.release_state(epsilon), np.zeros(3), times[-1]).state(times)
         errors.append(np.max(np.abs(expansion.displacement(times, epsilon) - exact)))
     assert np.polyfit(np.log(epsilons), np.log(errors), 1)[0] == pytest.approx(2, abs=0.3)
+
+
+def test_nnm_problem_is_validated_and_kept_by_its_result():
+    chain = UnilateralSystem.chain(2, unilateral=[(0, 0.0)])
+    problem = lindstedt.NNMProblem(chain, mode=2, a0="3/4", a1=0.5)
+    assert problem.a0 == sympy.Rational(3, 4) and problem.a1 == sympy.Rational(1, 2)
+    result = lindstedt.StrainedCoordinatesNNM(precision=30).expand(problem, order=2)
+    assert result.problem is problem and result.system is chain and result.mode == 2 and result.a0 == 0.75
+    assert result.omega == lindstedt.nnm(chain, mode=2, a0="3/4", a1=0.5, order=2).omega
+    for bad in ({"mode": 0}, {"mode": 3}, {"mode": True}, {"a0": 0}, {"a0": "nan"}, {"a1": "x"}):
+        with pytest.raises(ProblemError):
+            lindstedt.NNMProblem(**{"system": chain, "mode": 1, "a0": 1, **bad})
+    with pytest.raises(ProblemError):
+        lindstedt.NNMProblem("system.json", mode=1, a0=1)

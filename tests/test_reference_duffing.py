@@ -8,18 +8,26 @@ independently, and direct numerical integration of the ODE with scipy.
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
-from fractions import Fraction
 
 import mpmath
 import numpy as np
 import pytest
 import sympy
 from scipy.integrate import quad, solve_ivp
+from sympy import QQ
+from sympy.polys.ring_series import (
+    rs_mul,
+    rs_pow,
+    rs_series_inversion,
+    rs_series_reversion,
+    rs_subs,
+)
+from sympy.polys.rings import ring
 
 from lindstedt import OrderError, ProblemError
-from lindstedt.algebra import PowerSeries
 from lindstedt.references import duffing_exact_frequency, duffing_frequency_taylor
 
 
@@ -83,19 +91,32 @@ def test_initial_series_matches_sympy_series_of_elliptic_closed_form():
     assert duffing_frequency_taylor(6, "initial") == expected
 
 
-def test_initial_series_matches_theta_function_route():
-    # Independent identities: 2K/pi = theta3**2, m = theta2**4/theta3**4 = 16 q psi**4/theta3**4.
-    order = 14
-    q = PowerSeries.variable(order)
-    theta3 = PowerSeries([1] + [2 if int(k**0.5) ** 2 == k else 0 for k in range(1, order + 1)])
-    psi = PowerSeries([1 if any(n * (n + 1) == k for n in range(order + 1)) else 0 for k in range(order + 1)])
-    parameter = q * 16 * psi.power(4) * theta3.power(-4)
-    strength = parameter * 2 / (1 - parameter * 2)  # x = 2m/(1-2m)
-    frequency_in_q = (1 - parameter * 2).power(Fraction(-1, 2)) / (theta3 * theta3)
-    expected = frequency_in_q.compose(strength.reversion())
-    assert duffing_frequency_taylor(order, "initial") == [
-        sympy.Rational(value.numerator, value.denominator) for value in expected.coefficients
-    ]
+def theta_function_route(order: int, normalization: str) -> list[sympy.Rational]:
+    """omega/omega0 in x (or y) from the theta-function identities, with sympy's own ring_series reversion and substitution.
+
+    2K/pi = theta3**2, m = theta2**4/theta3**4 = 16 q psi**4/theta3**4, x = 2m/(1-2m),
+    omega/omega0 = (1-2m)**(-1/2)/theta3**2 and the first-harmonic strength y = x/((1+q)**2 psi**4).
+    """
+    _, q, strength_variable = ring("q, s", QQ)
+    precision = order + 1
+    theta3 = 1 + 2 * sum(q ** (n * n) for n in range(1, math.isqrt(order) + 1))
+    psi = sum(q ** (n * (n + 1)) for n in range(order + 1) if n * (n + 1) <= order)
+    parameter = rs_mul(16 * q, rs_mul(rs_pow(psi, 4, q, precision), rs_pow(theta3, -4, q, precision), q, precision), q, precision)
+    strength = rs_mul(2 * parameter, rs_series_inversion(1 - 2 * parameter, q, precision), q, precision)
+    frequency = rs_mul(rs_pow(1 - 2 * parameter, sympy.Rational(-1, 2), q, precision), rs_pow(theta3, -2, q, precision), q, precision)
+    if normalization == "harmonic":
+        strength = rs_mul(strength, rs_pow(rs_mul(1 + q, rs_pow(psi, 2, q, precision), q, precision), -2, q, precision), q, precision)
+    nome = rs_series_reversion(strength, q, precision, strength_variable)
+    composed = rs_subs(frequency, {q: nome}, strength_variable, precision)
+    assert all(monomial[0] == 0 for monomial in composed)
+    return [QQ.to_sympy(composed.get((0, power), QQ.zero)) for power in range(order + 1)]
+
+
+@pytest.mark.parametrize("normalization", ["initial", "harmonic"])
+def test_series_match_theta_function_route(normalization):
+    # "initial" is computed from 2F1(1/2, 1/2; 1; m) by the reference, so the theta route is independent of it.
+    order = 16
+    assert duffing_frequency_taylor(order, normalization) == theta_function_route(order, normalization)
 
 
 def test_series_are_prefixes_of_longer_series():

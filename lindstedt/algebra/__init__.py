@@ -1,4 +1,4 @@
-"""Exact algebra behind the expansions: cosine series, the contact Fourier kernel, power series.
+"""Exact algebra behind the expansions: cosine series and the contact Fourier kernel.
 
 Cosine series (2π-periodic, even)
     :class:`CosineSeries` ``v(s) = Σ_n c_n cos(n s)`` and :class:`SineSeries`
@@ -25,16 +25,11 @@ Contact Fourier kernel of a unilateral spring (``κ = b/|a0|``, ``β = arccos κ
     converging series they build (:func:`series_sum`,
     :func:`sum_cosine_series_at`, each a :class:`SeriesEstimate` ``(value, error_estimate)``).
 
-Truncated power series over the rationals
-    :class:`PowerSeries` ``c_0 + c_1 x + … + c_n x^n + O(x^{n+1})``: exact sums,
-    products, reciprocal, composition, reversion and rational powers;
-    :func:`binomial_series` ``(1 + x)^p``.
-
 Examples
 --------
 >>> import sympy
 >>> from sympy import QQ
->>> from lindstedt.algebra import CosineSeries, PowerSeries, contact_ramp_coefficient, solve_harmonic_oscillator
+>>> from lindstedt.algebra import CosineSeries, contact_ramp_coefficient, solve_harmonic_oscillator
 >>> s = sympy.Symbol("s")
 >>> (CosineSeries.cosine(QQ) ** 3).to_expr(s)             # cos³ s = (3 cos s + cos 3s)/4
 3*cos(s)/4 + cos(3*s)/4
@@ -42,8 +37,6 @@ Examples
 cos(s)/8 - cos(3*s)/8
 >>> contact_ramp_coefficient(2, 0)                        # c_2[0] = 2/(3π)
 2/(3*pi)
->>> [str(c) for c in PowerSeries([1, 1], order=3).power(sympy.Rational(1, 2)).coefficients]   # √(1 + x)
-['1', '1/2', '-1/8', '1/16']
 """
 
 from .._contact_fourier import (
@@ -62,7 +55,6 @@ from .._contact_fourier import (
     sum_cosine_series_at,
 )
 from .._cosine import CosineSeries, SecularTermError, SineSeries, solve_harmonic_oscillator
-from .._power_series import PowerSeries, binomial_series
 
 __all__ = [
     "CosineSeries",
@@ -82,6 +74,4 @@ __all__ = [
     "SeriesEstimate",
     "series_sum",
     "sum_cosine_series_at",
-    "PowerSeries",
-    "binomial_series",
 ]

@@ -30,6 +30,16 @@ Nonlinear normal modes by shooting
 
 The systems themselves are :class:`lindstedt.UnilateralSystem`.
 
+Layout (the pipeline, in order)
+    the exact flow (:class:`ExactFlow`, in ``lindstedt._flow``) →
+    :mod:`~lindstedt.numerics.sensitivity` (its exact derivatives in the initial
+    state and in ε) → :mod:`~lindstedt.numerics.shooting` (the shooting
+    residual and Jacobian, Newton, :func:`nnm_point`, :func:`nnm_energy`) →
+    :mod:`~lindstedt.numerics.continuation` (one continuation driver with the
+    methods "arclength", "natural" and "seed", and :func:`nnm_sweep`);
+    :mod:`~lindstedt.numerics.results` holds the result types and
+    :mod:`~lindstedt.numerics.examples` the seed's example system.
+
 Examples
 --------
 >>> import numpy as np
@@ -45,18 +55,11 @@ Examples
 """
 
 from .._flow import ExactFlow, FlowMapResult, FlowResult, SwitchEvent, smooth_flow
-from .._nnm_numeric import (
-    ContinuationProgress,
-    NNMBranch,
-    NNMResult,
-    NNMShooting,
-    continue_nnm,
-    flow_epsilon_derivative,
-    nnm_energy,
-    nnm_point,
-    nnm_sweep,
-    seed_example_system,
-)
+from .continuation import continue_nnm, nnm_sweep
+from .examples import seed_example_system
+from .results import ContinuationProgress, NNMBranch, NNMResult
+from .sensitivity import flow_epsilon_derivative
+from .shooting import NNMShooting, nnm_energy, nnm_point
 
 __all__ = [
     "ExactFlow",

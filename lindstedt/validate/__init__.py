@@ -4,12 +4,16 @@ The problem is ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0 + ε a1``, ``u'(0) =
 and ``u_N(t) = Σ_{k≤N} ε^k v_k(ω t)`` is its order-N Lindstedt–Poincaré expansion
 (:func:`lindstedt.expand`).
 
-True solution
+The modules follow the pipeline, each importing only the ones before it:
+
+True solution (:mod:`lindstedt.validate.solutions`)
     :func:`reference_solution` (a :class:`ReferenceSolution`): the closed-form
     arcs of the exact piecewise-linear flow for unilateral springs
-    ``a (u − b)_+`` (machine precision), DOP853 for smooth f.
+    ``a (u − b)_+`` (machine precision), DOP853 for smooth f;
+    :func:`exact_period` (:class:`ExactPeriod`): twice the first positive
+    zero of ``u'``.
 
-Errors and rates
+Errors and rates (:mod:`lindstedt.validate.errors`)
     :func:`expansion_error` (:class:`ExpansionError`): ``e(t) = u_N(t) − u(t)``
     and its phase-plane size ``ρ = ((u_N − u)² + ((u_N' − u')/ω0)²)^{1/2}``;
     :func:`fitted_convergence_order` (:class:`ConvergenceFit`): the slope of
@@ -19,22 +23,26 @@ Errors and rates
     :func:`loglog_fit` (:class:`LogLogFit`): the least-squares line through
     ``(log x, log y)`` behind these fits.
 
-Contact measure (Lemma 3.2)
+Contact measure, Lemma 3.2 (:mod:`lindstedt.validate.contact`)
     :func:`contact_measure` (:class:`ContactMeasure`):
     ``μ_ε(T) = |{t ∈ [0, T] : |u(t) − b| ≤ ε M}|``;
     :func:`fitted_contact_measure_order` (:class:`ContactMeasureFit`): the
     slope of ``log(μ_ε(T)/T)`` against ``log ε`` (1, or 1/2 at grazing).
 
-Spectra (also exported by :mod:`lindstedt`)
+Spectra (:mod:`lindstedt.validate.spectra`; also exported by :mod:`lindstedt`)
     :func:`spectrum` (:class:`Spectrum` of :class:`SpectralPeak` lines): the
     line spectrum ``|c_0|, |c_k − i s_k|`` of a periodic signal sampled over
     whole periods; :func:`expansion_spectrum` samples ``u_N`` over periods of
     its own ω(ε), :func:`exact_spectrum` the true solution over its exact
-    period :func:`exact_period` (:class:`ExactPeriod`).
+    period :func:`exact_period`.
 
 Plots
     :func:`line_plot_svg`: a dependency-free SVG line plot (error curves of
     ``lindstedt demo`` and of the benchmarks).
+
+Every numerical result is a frozen dataclass with ``success``, ``message``
+and counters (samples, reference solves, switches, right-hand-side or gap
+evaluations).
 
 Examples
 --------
@@ -48,24 +56,20 @@ Examples
 2.0
 """
 
-from .._spectrum import ExactPeriod, SpectralPeak, Spectrum, exact_period, exact_spectrum, expansion_spectrum, spectrum
 from .._svg import line_plot_svg
-from .._validation import (
-    ContactMeasure,
-    ContactMeasureFit,
+from .contact import ContactMeasure, ContactMeasureFit, contact_measure, fitted_contact_measure_order
+from .errors import (
     ConvergenceFit,
     ExpansionError,
     LogLogFit,
-    ReferenceSolution,
     ValidityFit,
-    contact_measure,
     expansion_error,
-    fitted_contact_measure_order,
     fitted_convergence_order,
     fitted_validity_exponent,
     loglog_fit,
-    reference_solution,
 )
+from .solutions import ExactPeriod, ReferenceSolution, exact_period, reference_solution
+from .spectra import SpectralPeak, Spectrum, exact_spectrum, expansion_spectrum, spectrum
 
 __all__ = [
     "reference_solution",

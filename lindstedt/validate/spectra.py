@@ -1,4 +1,4 @@
-"""Fourier spectra of periodic solutions of  u'' + ω0² u + ε f(u) = 0  (figure 2 of the seed).
+"""Line spectra of periodic solutions of  u'' + ω0² u + ε f(u) = 0,  labelled in harmonics (figure 2 of the seed).
 
 For a T-periodic signal ``u(t) = c_0 + Σ_{k≥1} c_k cos(kΩt) + s_k sin(kΩt)``
 (``Ω = 2π/T``) sampled at ``n`` equally spaced points over ``m`` whole periods,
@@ -22,26 +22,32 @@ multiple ``k`` of the fundamental Ω when within half a bin of it
 
 Helpers: :func:`expansion_spectrum` samples ``Σ_k ε^k v_k(ωt)`` over whole
 periods of its own ω(ε); :func:`exact_spectrum` samples the true solution
-(:func:`lindstedt._validation.reference_solution`) over whole periods of its
-exact period, found as twice the first positive zero of u' (the solution is
-even about t = 0 and about every turning point).
+(:func:`lindstedt.validate.reference_solution`) over whole periods of its
+exact period (:func:`lindstedt.validate.exact_period`).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Mapping, Sequence
 
 import numpy as np
-import scipy.optimize
 
-from ._errors import ProblemError
-from ._expansion import Expansion
-from ._problem import Oscillator
-from ._validation import DEFAULT_ATOL, DEFAULT_RTOL, _numeric_problem, _problem_of, reference_solution
+from .._errors import ProblemError
+from .._expansion import Expansion
+from .._problem import Oscillator
+from .solutions import (
+    DEFAULT_ATOL,
+    DEFAULT_RTOL,
+    _as_positive,
+    _problem_of,
+    _require_expansion,
+    exact_period,
+    reference_solution,
+)
 
-__all__ = ["SpectralPeak", "Spectrum", "spectrum", "expansion_spectrum", "exact_spectrum", "exact_period"]
+__all__ = ["SpectralPeak", "Spectrum", "spectrum", "expansion_spectrum", "exact_spectrum"]
 
 WINDOWS = ("rectangular", "hann")
 #: log10 of the relative amplitude below which a local maximum is not reported as a peak
@@ -199,29 +205,23 @@ def spectrum(
         raise ProblemError(f"a spectrum needs at least 4 samples, got {n}")
     if not np.all(np.isfinite(values)):
         raise ProblemError("samples must be finite")
-    try:
-        length = float(duration)
-    except (TypeError, ValueError):
-        raise ProblemError(f"duration must be a positive number, got {duration!r}") from None
-    if not (math.isfinite(length) and length > 0):
-        raise ProblemError(f"duration must be a positive finite number, got {duration!r}")
+    length = _as_positive(duration, "duration")
     if periods is not None and fundamental is not None:
         raise ProblemError("give either periods= or fundamental=, not both")
-    whole = False
+    # cycles: the number of fundamental periods in the window, when known
+    cycles: float | None = None
+    fundamental_value: float | None = None
     if periods is not None:
-        periods = float(periods)
-        if not (math.isfinite(periods) and periods > 0):
-            raise ProblemError(f"periods must be positive, got {periods!r}")
-        fundamental_value: float | None = 2 * math.pi * periods / length
-        whole = abs(periods - round(periods)) <= 1e-9 * max(1.0, periods)
+        cycles = float(periods)
+        if not (math.isfinite(cycles) and cycles > 0):
+            raise ProblemError(f"periods must be positive, got {cycles!r}")
+        fundamental_value = 2 * math.pi * cycles / length
     elif fundamental is not None:
         fundamental_value = float(fundamental)
         if not (math.isfinite(fundamental_value) and fundamental_value > 0):
             raise ProblemError(f"fundamental must be a positive angular frequency, got {fundamental!r}")
         cycles = fundamental_value * length / (2 * math.pi)
-        whole = abs(cycles - round(cycles)) <= 1e-9 * max(1.0, cycles)
-    else:
-        fundamental_value = None
+    whole = cycles is not None and abs(cycles - round(cycles)) <= 1e-9 * max(1.0, cycles)
     if window is None:
         window = "rectangular" if whole else "hann"
     if window not in WINDOWS:
@@ -249,10 +249,8 @@ def spectrum(
     # bin 1 under a Hann window as large as the mean)
     padded = np.concatenate([[-np.inf], np.abs(transform), [-np.inf]])
     is_peak = (padded[1:-1] > padded[:-2]) & (padded[1:-1] >= padded[2:])
-    if window == "rectangular" and whole and periods is not None:
-        is_peak |= np.arange(transform.size) % int(round(periods)) == 0
-    elif window == "rectangular" and whole and fundamental_value is not None:
-        is_peak |= np.arange(transform.size) % int(round(fundamental_value * length / (2 * math.pi))) == 0
+    if window == "rectangular" and whole:
+        is_peak |= np.arange(transform.size) % int(round(cycles)) == 0
     is_peak &= relative >= peak_floor
     spacing = 2 * math.pi / length
     peaks = []
@@ -279,9 +277,7 @@ def spectrum(
         peaks=tuple(peaks),
         window=window,
         duration=length,
-        periods=periods if periods is not None else (
-            fundamental_value * length / (2 * math.pi) if fundamental_value is not None else None
-        ),
+        periods=cycles,
         n_samples=n,
     )
 
@@ -292,6 +288,16 @@ def _check_sampling(periods: int, samples_per_period: int) -> tuple[int, int]:
     if isinstance(samples_per_period, bool) or int(samples_per_period) != samples_per_period or samples_per_period < 8:
         raise ProblemError(f"samples_per_period must be an integer ≥ 8, got {samples_per_period!r}")
     return int(periods), int(samples_per_period)
+
+
+def _window_times(duration: float, periods: int, samples_per_period: int) -> np.ndarray:
+    """``samples_per_period`` equally spaced times per period over ``[0, duration)``."""
+    n = periods * samples_per_period
+    return np.arange(n) * (duration / n)
+
+
+def _with_message(result: Spectrum, prefix: str, success: bool = True) -> Spectrum:
+    return replace(result, message=prefix + result.message, success=result.success and success)
 
 
 def expansion_spectrum(
@@ -324,101 +330,16 @@ def expansion_spectrum(
     (``u_N`` switches branches at the moving contact angle ``β + σ_1 ε``, so
     it differs from the Fourier series of ``v_0 + ε v_1`` by ``O(ε^5)`` here.)
     """
-    if not isinstance(expansion, Expansion):
-        raise ProblemError(f"expansion_spectrum needs an Expansion, got {type(expansion).__name__}")
+    _require_expansion(expansion, "expansion_spectrum")
     periods, samples_per_period = _check_sampling(periods, samples_per_period)
     omega = float(expansion.frequency(float(epsilon), values, order=expansion.order + 1))
     if not omega > 0:
         raise ProblemError(f"ω(ε) = {omega} is not positive at ε = {epsilon}: ε is too large for this expansion")
     duration = periods * 2 * math.pi / omega
-    n = periods * samples_per_period
-    times = np.arange(n) * (duration / n)
+    times = _window_times(duration, periods, samples_per_period)
     samples = np.asarray(expansion.displacement(times, float(epsilon), values), dtype=float)
     result = spectrum(samples, duration, periods=periods, peak_floor=peak_floor)
     return _with_message(result, f"expansion of order {expansion.order} at ε = {epsilon:g}, ω = {omega:.15g}; ")
-
-
-def _with_message(result: Spectrum, prefix: str, success: bool = True) -> Spectrum:
-    from dataclasses import replace
-
-    return replace(result, message=prefix + result.message, success=result.success and success)
-
-
-@dataclass(frozen=True)
-class ExactPeriod:
-    """Exact period of the true solution.
-
-    Attributes
-    ----------
-    success, message
-        As usual.
-    period : float
-        ``P = 2 t_½`` with ``t_½`` the first positive zero of u'.
-    half_period : float
-        ``t_½``.
-    n_root_evaluations : int
-        Dense-output evaluations used by Brent's method.
-    reference_method : str
-        How the true solution was computed.
-    """
-
-    success: bool
-    message: str
-    period: float
-    half_period: float
-    n_root_evaluations: int
-    reference_method: str
-
-
-def exact_period(
-    source: Oscillator | Expansion,
-    epsilon: float,
-    *,
-    values: Mapping[Any, Any] | None = None,
-    a1: float = 0.0,
-    rtol: float = DEFAULT_RTOL,
-    atol: float = DEFAULT_ATOL,
-) -> ExactPeriod:
-    """Period of the true solution: twice the first positive zero of u'.
-
-    The motion from ``u'(0) = 0`` is even about ``t = 0`` and about each
-    turning point (the equation is conservative and reversible), so the
-    second turning point is at half the period.
-
-    Examples
-    --------
-    >>> import lindstedt
-    >>> p = exact_period(lindstedt.Oscillator("Max(0, u)", a0=1, omega0=1), 3.0)
-    >>> round(p.period, 12) == round(np.pi / 2 + np.pi, 12)      # π/ω' + π/ω0 with ω' = 2
-    True
-    """
-    numeric = _numeric_problem(source, values)
-    linear_period = 2 * math.pi / numeric.omega0
-    horizon = 2.0 * linear_period
-    reference = reference_solution(source, epsilon, [horizon], values=values, a1=a1, rtol=rtol, atol=atol)
-    grid = np.linspace(0.0, horizon, 2049)
-    _, velocity = reference.state(grid)
-    start_sign = np.sign(velocity[1:8][np.nonzero(velocity[1:8])[0][0]]) if np.any(velocity[1:8]) else 0.0
-    changes = np.flatnonzero(np.sign(velocity[1:]) == -start_sign)
-    counter = [0]
-
-    def speed(t: float) -> float:
-        counter[0] += 1
-        return float(reference.state(np.array([t]))[1][0])
-
-    if start_sign == 0 or changes.size == 0:
-        return ExactPeriod(False, "u' has no positive zero within two linear periods (rest state or too large ε?)",
-                           math.nan, math.nan, counter[0], reference.method)
-    k = int(changes[0]) + 1
-    half = float(scipy.optimize.brentq(speed, grid[k - 1], grid[k], xtol=1e-15, rtol=4 * np.finfo(float).eps))
-    return ExactPeriod(
-        success=reference.success,
-        message=f"P = {2 * half:.16g} ({reference.method}); {reference.message}",
-        period=2 * half,
-        half_period=half,
-        n_root_evaluations=counter[0],
-        reference_method=reference.method,
-    )
 
 
 def exact_spectrum(
@@ -448,8 +369,7 @@ def exact_spectrum(
     if not math.isfinite(period.period):
         raise ProblemError(f"cannot sample whole periods: {period.message}")
     duration = periods * period.period
-    n = periods * samples_per_period
-    times = np.arange(n) * (duration / n)
+    times = _window_times(duration, periods, samples_per_period)
     reference = reference_solution(source, epsilon, times, values=values, a1=a1, rtol=rtol, atol=atol)
     result = spectrum(reference.displacement, duration, periods=periods, peak_floor=peak_floor)
     prefix = f"exact solution of {problem.describe()} at ε = {epsilon:g}, P = {period.period:.16g}; "

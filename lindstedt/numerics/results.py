@@ -1,0 +1,296 @@
+"""Results of the NNM computations: one periodic orbit (:class:`NNMResult`) and a branch of them (:class:`NNMBranch`).
+
+An NNM of ``M X'' + K X + ε W (A X − b)_+ = 0`` is reported with its frequency
+``ω = 2π/T``, release state ``(X0, X1)``, modal coordinates ``u(0) = Φᵀ M X0``,
+energy, Floquet multipliers (eigenvalues of the monodromy matrix) and the cost
+of the computation; a failure carries its reason and is never raised.  A
+continuation returns an :class:`NNMBranch` (points in branch order, folds,
+stability and contact changes) and reports its progress as
+:class:`ContinuationProgress`.
+
+Examples
+--------
+>>> import lindstedt
+>>> result = lindstedt.nnm_point(lindstedt.UnilateralSystem.one_dof(1), 3.0, 1, modal_amplitude=1.0)
+>>> type(result).__name__, result.success, result.contact, result.modal_amplitude
+('NNMResult', True, True, 1.0)
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = ["ContinuationProgress", "NNMBranch", "NNMResult"]
+
+
+@dataclass(frozen=True)
+class NNMResult:
+    """One nonlinear normal mode (a periodic orbit), or why it could not be computed.
+
+    Attributes
+    ----------
+    success : bool
+        True only if the orbit was verified: one more flow over the full
+        period from the final state returns to it within ``verify_tol``.
+    message : str
+        What happened; on failure why (no convergence, singular Jacobian —
+        fold or bifurcation —, impossible energy, flow failure, failed
+        verification).  Mentions "no contact" when the orbit never touches
+        the springs (it is then the linear mode, ω = λ_j).
+    mode : int
+        1-based mode number j the NNM grows from.
+    epsilon : float
+    frequency : float
+        ω = 2π / T (NaN on failure).
+    period : float
+        T.
+    linear_frequency : float
+        λ_j.
+    release_position, release_velocity : numpy.ndarray, shape (N,)
+        Initial state X0, X1 (X1 = 0 for the symmetric formulation).
+    modal_coordinates : numpy.ndarray, shape (N,)
+        ``u(0) = Φᵀ M X0`` (release modal coordinates; ``u_j(0)`` is the modal amplitude).
+    energy : float
+        :func:`nnm_energy` of the release state.
+    floquet_multipliers : numpy.ndarray, shape (2N,) or None
+        Eigenvalues of the monodromy matrix (over one full period), sorted by
+        distance to 1: the first two are the trivial ones (time shift and
+        family direction), equal to 1 up to about ``sqrt(machine ε)``.
+    stable : bool or None
+        Linear stability: all multipliers within ``1 + stability_tol`` of the unit circle.
+    residual : float
+        Relative periodicity residual of the verification flow,
+        ``max(|X(T) − X0|/x_s, |X'(T) − X1|/(ω x_s))``, x_s the orbit's scale.
+    n_switches : int
+        Contact switches per period (0: no contact).
+    mode_share : float
+        Share of mode j in the linear modal energies ``½ (u̇_k² + λ_k² u_k²)``
+        of the release state (1 for the linear mode).
+    formulation : str
+        ``"symmetric"``, ``"full"`` or ``"seed"`` (the baseline's residual).
+    newton_iterations : int
+        Newton (or hybr) iterations.
+    flow_evaluations : int
+        Flow integrations used, including the verification flow.
+    monodromy : numpy.ndarray or None
+        The 2N × 2N monodromy matrix.
+    """
+
+    success: bool
+    message: str
+    mode: int
+    epsilon: float
+    frequency: float
+    period: float
+    linear_frequency: float
+    release_position: np.ndarray
+    release_velocity: np.ndarray
+    modal_coordinates: np.ndarray
+    energy: float
+    floquet_multipliers: np.ndarray | None
+    stable: bool | None
+    residual: float
+    n_switches: int
+    mode_share: float
+    formulation: str
+    newton_iterations: int
+    flow_evaluations: int
+    monodromy: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def contact(self) -> bool:
+        """Whether the orbit touches a unilateral spring (switches during a period)."""
+        return self.n_switches > 0
+
+    @property
+    def modal_amplitude(self) -> float:
+        """``u_j(0)``, the release modal coordinate of the NNM's own mode."""
+        return float(self.modal_coordinates[self.mode - 1])
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready data (schema ``lindstedt.nnm-numeric/1``); NaN and infinities become ``None``.
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> chain = lindstedt.UnilateralSystem.chain(2, unilateral=[(0, 0)])
+        >>> data = lindstedt.nnm_point(chain, 0.05, 1, modal_amplitude=1.0).to_dict()
+        >>> data["success"], data["status"], round(data["frequency"], 6)
+        (True, 'converged', 1.006128)
+        """
+
+        def number(value: Any) -> float | None:
+            return float(value) if math.isfinite(value) else None
+
+        multipliers = [] if self.floquet_multipliers is None else [[number(z.real), number(z.imag)] for z in self.floquet_multipliers]
+        return {
+            "schema": "lindstedt.nnm-numeric/1",
+            "success": bool(self.success),
+            "status": "converged" if self.success else "failed",
+            "message": self.message,
+            "mode": self.mode,
+            "epsilon": number(self.epsilon),
+            "frequency": number(self.frequency),
+            "period": number(self.period),
+            "linear_frequency": number(self.linear_frequency),
+            "release_position": [number(x) for x in self.release_position],
+            "release_velocity": [number(x) for x in self.release_velocity],
+            "modal_coordinates": [number(x) for x in self.modal_coordinates],
+            "energy": number(self.energy),
+            "floquet_multipliers": multipliers,
+            "stable": self.stable,
+            "residual": number(self.residual),
+            "n_switches": self.n_switches,
+            "formulation": self.formulation,
+            "newton_iterations": self.newton_iterations,
+            "flow_evaluations": self.flow_evaluations,
+        }
+
+    def to_json(self, indent: int | None = 2) -> str:
+        """Strict JSON text of :meth:`to_dict` (never NaN)."""
+        import json
+
+        return json.dumps(self.to_dict(), indent=indent, allow_nan=False)
+
+    def summary(self) -> str:
+        """One line: mode, ε, ω, T, energy, stability, cost."""
+        if not self.success:
+            return f"mode {self.mode}, ε = {self.epsilon:g}: FAILED — {self.message}"
+        largest = float(np.max(np.abs(self.floquet_multipliers))) if self.floquet_multipliers is not None else float("nan")
+        return (
+            f"mode {self.mode}, ε = {self.epsilon:g}: ω = {self.frequency:.12g} (λ_j = {self.linear_frequency:.12g}), "
+            f"T = {self.period:.12g}, E = {self.energy:.6g}, max|μ| = {largest:.6g} "
+            f"({'stable' if self.stable else 'unstable'}), {self.n_switches} switches/period, "
+            f"{self.newton_iterations} iterations, {self.flow_evaluations} flows"
+        )
+
+
+def _failed(mode: int, epsilon: float, linear_frequency: float, n: int, message: str, formulation: str,
+            iterations: int, flows: int, x0: np.ndarray | None = None) -> NNMResult:
+    position = np.full(n, np.nan) if x0 is None else np.array(x0, dtype=float)
+    return NNMResult(
+        success=False, message=message, mode=mode, epsilon=epsilon, frequency=float("nan"), period=float("nan"),
+        linear_frequency=linear_frequency, release_position=position, release_velocity=np.full(n, np.nan),
+        modal_coordinates=np.full(n, np.nan), energy=float("nan"), floquet_multipliers=None, stable=None,
+        residual=float("nan"), n_switches=0, mode_share=float("nan"), formulation=formulation, newton_iterations=iterations,
+        flow_evaluations=flows,
+    )
+
+
+
+@dataclass(frozen=True)
+class ContinuationProgress:
+    """Passed to the continuation callback after every accepted point.
+
+    Attributes
+    ----------
+    index : int
+        Index of the point in the branch (0 = first).
+    parameter : float
+        Value of the continuation parameter.
+    result : NNMResult
+        The accepted point.
+    step : float
+        Current step (arclength for "arclength", parameter increment otherwise).
+    flow_evaluations : int
+        Flows used so far by the whole continuation.
+    """
+
+    index: int
+    parameter: float
+    result: NNMResult
+    step: float
+    flow_evaluations: int
+
+
+@dataclass(frozen=True)
+class NNMBranch:
+    """A branch of NNMs from a continuation.
+
+    Attributes
+    ----------
+    success : bool
+        Whether the continuation reached ``stop``.
+    stop_reason : str
+        Why it stopped ("reached stop = …", "max_points …", "step size … below
+        min_step …: <corrector failure>", "callback requested stop", "first
+        point failed: …").
+    method : str
+        ``"arclength"``, ``"natural"`` or ``"seed"``.
+    parameter : str
+        ``"epsilon"``, ``"energy"`` or ``"modal_amplitude"``.
+    points : tuple of NNMResult
+        The accepted points in branch order.
+    parameter_values : numpy.ndarray
+        The parameter at each point.
+    folds : tuple of int
+        Indices k such that the parameter turns back between points k and k + 1.
+    stability_changes : tuple of int
+        Indices k such that stability differs between points k and k + 1.
+    contact_changes : tuple of int
+        Indices k such that contact (switches per period > 0) differs between points k and k + 1.
+    flow_evaluations : int
+        Total flow integrations (including rejected steps and verifications).
+    newton_iterations : int
+        Total corrector iterations (Newton or hybr).
+    rejected_steps : int
+        Steps that failed and were retried with a smaller step.
+    wall_time : float
+        Seconds.
+    """
+
+    success: bool
+    stop_reason: str
+    method: str
+    parameter: str
+    points: tuple[NNMResult, ...]
+    parameter_values: np.ndarray
+    folds: tuple[int, ...]
+    stability_changes: tuple[int, ...]
+    contact_changes: tuple[int, ...]
+    flow_evaluations: int
+    newton_iterations: int
+    rejected_steps: int
+    wall_time: float
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """ω at each point."""
+        return np.array([p.frequency for p in self.points])
+
+    @property
+    def epsilons(self) -> np.ndarray:
+        """ε at each point."""
+        return np.array([p.epsilon for p in self.points])
+
+    @property
+    def energies(self) -> np.ndarray:
+        """Energy (:func:`nnm_energy`) at each point."""
+        return np.array([p.energy for p in self.points])
+
+    @property
+    def stable(self) -> np.ndarray:
+        """Stability flag at each point."""
+        return np.array([bool(p.stable) for p in self.points])
+
+
+def _branch_events(points: Sequence[NNMResult], values: Sequence[float]) -> tuple[tuple[int, ...], ...]:
+    folds, stability, contact = [], [], []
+    increments = np.diff(np.asarray(values, dtype=float))
+    for k in range(len(increments) - 1):
+        if increments[k] * increments[k + 1] < 0:
+            folds.append(k + 1)
+    for k in range(len(points) - 1):
+        if points[k].stable != points[k + 1].stable:
+            stability.append(k)
+        if points[k].contact != points[k + 1].contact:
+            contact.append(k)
+    return tuple(folds), tuple(stability), tuple(contact)

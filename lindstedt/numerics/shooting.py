@@ -1,0 +1,701 @@
+"""NNM shooting for  M X'' + K X + ε W (A X − b)_+ = 0 : the residual, its exact Jacobian, Newton, one orbit.
+
+A nonlinear normal mode (NNM, in Rosenberg's sense) of mode j is a periodic
+orbit that grows out of the linear mode ``φ_j`` (``K φ_j = λ_j² M φ_j``,
+``Φᵀ M Φ = I``) as ε → 0 or as the amplitude → 0.  It is computed here by
+*shooting*: unknown initial state and period, residuals evaluated with the
+exact piecewise closed-form flow (:class:`lindstedt.numerics.ExactFlow`), and a
+Newton (Gauss–Newton) iteration whose Jacobian is exact — the state transition
+matrix of the flow over T/2 or T (over a full period: the monodromy matrix),
+the vector field at the end point for the derivative in T, and a closed-form
+Duhamel integral for the derivative in ε (:mod:`lindstedt.numerics.sensitivity`).
+No finite differences are used.
+
+Formulations (``formulation=``)
+-------------------------------
+``"full"`` — the seed's formulation (section 4.3.2) plus a phase condition.
+    Unknowns ``(X0, X1, T)`` (2N + 1); residuals (2N + 2, consistent)::
+
+        X(T) − X0,   X'(T) − X1,   amplitude(X0, X1) − target,   φ_jᵀ M X1
+
+    The last row is the phase condition: the orbit is started where the
+    modal velocity of mode j vanishes, which removes the time-shift
+    invariance without assuming any symmetry (for the brake orbits of these
+    time-reversible systems it selects a turning point, so ``X1 = 0`` at the
+    solution).  One periodicity row is redundant on a family of periodic
+    orbits (energy conservation, or reversibility when ``W ≠ Aᵀ``), so the
+    system is solved in the least-squares (Gauss–Newton) sense: it converges
+    quadratically because the residual vanishes at the solution.
+
+``"symmetric"`` (default) — time-reversible orbits released from rest.
+    The force depends on positions only, so ``t → −t`` maps solutions to
+    solutions; an orbit with ``X'(0) = 0`` and ``X'(T/2) = 0`` is T-periodic.
+    Unknowns ``(X0, T)`` (N + 1), square system::
+
+        X'(T/2; X0, X'(0) = 0) = 0,   amplitude(X0, 0) − target
+
+    Half the integration time, half the unknowns, better conditioned.
+
+Amplitude (exactly one of)
+--------------------------
+``energy=E``
+    ``E(X0, X1) = E``.  For ``W = Aᵀ`` this is the conserved energy
+    ``½ X'ᵀ M X' + ½ Xᵀ K X + ½ ε Σ (A X − b)_+²``; for ``W ≠ Aᵀ`` (e.g. the
+    seed's example, which has no conserved energy) it is the *linear* energy
+    ``½ X'ᵀ M X' + ½ Xᵀ K X`` at the release point (see :func:`nnm_energy`).
+``energy_per_epsilon=c``
+    The seed's ``E = c ε`` (the amplitude grows with ε).
+``modal_amplitude=a0``
+    ``u_j(0) = φ_jᵀ M X0 = a0``, i.e. ``X0 = Φ (a0 e_j + Σ_{k≠j} q_k e_k)``
+    with the ``q_k`` free — directly comparable with a Lindstedt–Poincaré
+    NNM expansion (``ω(ε) = λ_j + ε ω_1 + ε² ω_2``, ``u_k(0) = ε a_k``; see
+    :func:`lindstedt.nnm`).
+
+Modes are numbered from 1 (``mode=1`` is the lowest λ), as in the seed and in
+:func:`lindstedt.nnm`.
+
+Newton and verification
+-----------------------
+The Newton iteration is damped (backtracking on the scaled residual), solves
+in the least-squares sense with column scaling, and stops on a singular
+Jacobian (a fold, a bifurcation or a degenerate amplitude) with that reason.
+Every result is verified on its final state with one more flow over the full
+period: the periodicity residual is recomputed and the monodromy matrix gives
+the Floquet multipliers; an orbit that fails this check is never reported as a
+success.  A single solve from the linear-mode guess also rejects an orbit in
+which mode j does not carry at least half of the modal energy (Newton from a
+distant guess can land on another periodic orbit).  Branches of orbits are
+followed by :mod:`lindstedt.numerics.continuation`.
+
+Examples
+--------
+>>> orbit = nnm_point(UnilateralSystem.one_dof(1), 1.0, 1, energy=0.5, formulation="full")
+>>> orbit.success, round(orbit.frequency, 12) == round(2 * 2**0.5 / (1 + 2**0.5), 12)
+(True, True)
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .._errors import ConvergenceError, ProblemError
+from .._flow import ExactFlow
+from .._parsing import parse_float
+from .._system import UnilateralSystem
+from .results import NNMResult, _failed
+from .sensitivity import _check_epsilon, _integrate
+
+__all__ = ["NNMShooting", "nnm_energy", "nnm_point"]
+
+_TWO_PI = 2.0 * math.pi
+_FORMULATIONS = ("symmetric", "full")
+#: relative σ_min/σ_max below which a Newton matrix is declared singular
+_SINGULAR_RATIO = 1e-13
+#: a scaled Newton step this small ends the iteration (the caller verifies the final state)
+_STEP_TOL = 1e-7
+
+
+# --------------------------------------------------------------------------- #
+# energy and amplitude
+# --------------------------------------------------------------------------- #
+def nnm_energy(system: UnilateralSystem, x: Any, v: Any, epsilon: float) -> float:
+    """The energy used to parametrise NNMs.
+
+    ``W = Aᵀ``: the conserved energy ``½ X'ᵀ M X' + ½ Xᵀ K X + ½ ε Σ (A X − b)_+²``.
+    ``W ≠ Aᵀ`` (no conserved energy exists): the linear energy
+    ``½ X'ᵀ M X' + ½ Xᵀ K X`` of the given state — for an NNM, of its release
+    point.
+
+    Examples
+    --------
+    >>> nnm_energy(UnilateralSystem.one_dof(1), [2.0], [1.0], 0.5)
+    3.5
+    >>> from lindstedt.numerics import seed_example_system
+    >>> nnm_energy(seed_example_system(2), [1.0, 0.0], [0.0, 0.0], 0.5)
+    1.0
+    """
+    x = np.asarray(x, dtype=float)
+    v = np.asarray(v, dtype=float)
+    value = 0.5 * float(v @ system.M @ v) + 0.5 * float(x @ system.K @ x)
+    if system.symmetric_coupling and system.n_springs:
+        value += 0.5 * float(epsilon) * float(np.sum(np.maximum(system.gaps(x), 0.0) ** 2))
+    return value
+
+
+def _energy_gradient(
+    system: UnilateralSystem, x: np.ndarray, v: np.ndarray, epsilon: float
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """(∂E/∂x, ∂E/∂v, ∂E/∂ε) of :func:`nnm_energy`."""
+    grad_x = system.K @ x
+    d_eps = 0.0
+    if system.symmetric_coupling and system.n_springs:
+        engaged = np.maximum(system.gaps(x), 0.0)
+        grad_x = grad_x + epsilon * system.A.T @ engaged
+        d_eps = 0.5 * float(np.sum(engaged**2))
+    return grad_x, system.M @ v, d_eps
+
+
+def _equilibrium(system: UnilateralSystem, epsilon: float) -> np.ndarray:
+    """Static equilibrium ``K X + ε W (A X − b)_+ = 0`` by active-set iteration (X = 0 when b ≥ 0)."""
+    n = system.n_dof
+    if system.n_springs == 0 or np.all(system.b >= 0):
+        return np.zeros(n)
+    x = np.zeros(n)
+    seen = set()
+    for _ in range(2 ** min(system.n_springs, 12) + 1):
+        state = tuple(bool(g > 0) for g in system.gaps(x))
+        if state in seen:
+            break
+        seen.add(state)
+        mask = np.array(state)
+        stiffness = system.K + epsilon * system.W[:, mask] @ system.A[mask]
+        x = np.linalg.solve(stiffness, epsilon * system.W[:, mask] @ system.b[mask])
+    return x
+
+
+@dataclass(frozen=True)
+class _Amplitude:
+    """amplitude(X0, X1; ε) − target(ε): kind ∈ {"energy", "energy_per_epsilon", "modal_amplitude"}."""
+
+    kind: str
+    value: float
+
+    def target(self, epsilon: float) -> float:
+        return self.value * epsilon if self.kind == "energy_per_epsilon" else self.value
+
+    def d_target_d_epsilon(self) -> float:
+        return self.value if self.kind == "energy_per_epsilon" else 0.0
+
+    def d_target_d_value(self, epsilon: float) -> float:
+        return epsilon if self.kind == "energy_per_epsilon" else 1.0
+
+
+def _amplitude_spec(energy: Any, modal_amplitude: Any, energy_per_epsilon: Any) -> _Amplitude:
+    given = [(name, value) for name, value in (("energy", energy), ("modal_amplitude", modal_amplitude),
+                                               ("energy_per_epsilon", energy_per_epsilon)) if value is not None]
+    if len(given) != 1:
+        raise ProblemError(
+            "give exactly one amplitude: energy=E, modal_amplitude=a0 (u_j(0) = a0) or energy_per_epsilon=c "
+            f"(the seed's E = c ε); got {[name for name, _ in given] or 'none'}"
+        )
+    name, value = given[0]
+    return _Amplitude(name, parse_float(value, what=name))
+
+
+def _check_mode(system: UnilateralSystem, mode: Any) -> int:
+    if isinstance(mode, bool) or not isinstance(mode, (int, np.integer)) or not 1 <= mode <= system.n_dof:
+        raise ProblemError(
+            f"mode must be an integer in 1..{system.n_dof} (1 = lowest linear frequency, as in the seed), got {mode!r}"
+        )
+    return int(mode)
+
+
+# --------------------------------------------------------------------------- #
+# the shooting problem
+# --------------------------------------------------------------------------- #
+class NNMShooting:
+    """Residual and exact Jacobian of the NNM shooting problem of one mode.
+
+    Parameters
+    ----------
+    system : UnilateralSystem
+    mode : int
+        1-based mode number j.
+    energy, modal_amplitude, energy_per_epsilon : float
+        Exactly one: the amplitude condition (see the module docstring).
+    formulation : {"symmetric", "full"}
+        Unknowns ``(X0, T)`` or ``(X0, X1, T)``.
+    release_sign : {1, -1}
+        For energy amplitudes: release on the side ``+φ_j`` (default) or ``−φ_j``.
+
+    Notes
+    -----
+    Residual rows are scaled (velocities by ``λ_j x_s``, positions by ``x_s``,
+    the amplitude equation by its target), ``x_s`` being the amplitude of the
+    linear-mode guess; the Jacobian is with respect to the unscaled unknowns.
+    Each call of :meth:`evaluate` is one flow integration.
+
+    Examples
+    --------
+    >>> problem = NNMShooting(UnilateralSystem.one_dof(1), 1, modal_amplitude=1.0)
+    >>> guess = problem.initial_guess(0.0)
+    >>> guess.tolist() == [1.0, 2 * np.pi]
+    True
+    >>> float(np.max(np.abs(problem.residual(guess, 0.0)))) < 1e-15   # ε = 0: the linear mode
+    True
+    """
+
+    def __init__(
+        self,
+        system: UnilateralSystem,
+        mode: int,
+        *,
+        energy: float | None = None,
+        modal_amplitude: float | None = None,
+        energy_per_epsilon: float | None = None,
+        formulation: str = "symmetric",
+        release_sign: int = 1,
+    ) -> None:
+        if not isinstance(system, UnilateralSystem):
+            raise ProblemError(f"system must be a UnilateralSystem, got {type(system).__name__}")
+        if formulation not in _FORMULATIONS:
+            raise ProblemError(f"formulation must be one of {_FORMULATIONS}, got {formulation!r}")
+        if release_sign not in (1, -1):
+            raise ProblemError(f"release_sign must be +1 or -1, got {release_sign!r}")
+        self.system = system
+        self.mode = _check_mode(system, mode)
+        self.amplitude = _amplitude_spec(energy, modal_amplitude, energy_per_epsilon)
+        self.formulation = formulation
+        self.release_sign = int(release_sign)
+        frequencies, shapes = system.modes()
+        self.n = system.n_dof
+        self.linear_frequency = float(frequencies[self.mode - 1])
+        self.shape = np.array(shapes[:, self.mode - 1])
+        self.modal_row = system.M @ self.shape  # u_j = (M φ_j)ᵀ X
+        self.projector = shapes.T @ system.M  # u = Φᵀ M X
+        self.n_unknowns = self.n + 1 if formulation == "symmetric" else 2 * self.n + 1
+        self._flows: dict[float, ExactFlow] = {}
+        self.flow_evaluations = 0
+        self.set_scales(epsilon=0.0)
+
+    # ------------------------------------------------------------------ scales
+    def _guess_amplitude(self, epsilon: float, amplitude: _Amplitude | None = None) -> tuple[np.ndarray, float]:
+        """Release position of the linear-mode guess and its modal amplitude."""
+        amplitude = amplitude or self.amplitude
+        equilibrium = _equilibrium(self.system, epsilon)
+        if amplitude.kind == "modal_amplitude":
+            offset = amplitude.value - float(self.modal_row @ equilibrium)
+            return equilibrium + offset * self.shape, offset
+        floor = nnm_energy(self.system, equilibrium, np.zeros(self.n), epsilon)
+        excess = max(amplitude.target(epsilon) - floor, 0.0)
+        offset = self.release_sign * math.sqrt(2.0 * excess) / self.linear_frequency
+        return equilibrium + offset * self.shape, offset
+
+    def set_scales(self, epsilon: float, x0: np.ndarray | None = None, period: float | None = None,
+                   amplitude: _Amplitude | None = None) -> None:
+        """Fix the residual scaling from a release state (default: the linear-mode guess)."""
+        amplitude = amplitude or self.amplitude
+        if x0 is None:
+            x0, _ = self._guess_amplitude(epsilon, amplitude)
+        scale = float(np.linalg.norm(x0))  # Euclidean: arclength steps measure the relative change of the shape
+        if not scale > 0:
+            scale = 1.0
+        self.position_scale = scale
+        self.period_scale = period if period else _TWO_PI / self.linear_frequency
+        self.velocity_scale = scale * _TWO_PI / self.period_scale
+        target = abs(amplitude.target(epsilon))
+        if amplitude.kind == "modal_amplitude":
+            self.amplitude_scale = target if target > 0 else scale
+        else:
+            self.amplitude_scale = target if target > 0 else 0.5 * (self.linear_frequency * scale) ** 2
+
+    def column_scales(self) -> np.ndarray:
+        """Typical magnitudes of the unknowns (for scaled Newton steps)."""
+        if self.formulation == "symmetric":
+            return np.r_[np.full(self.n, self.position_scale), self.period_scale]
+        return np.r_[np.full(self.n, self.position_scale), np.full(self.n, self.velocity_scale), self.period_scale]
+
+    # ------------------------------------------------------------------ pieces
+    def _flow(self, epsilon: float) -> ExactFlow:
+        flow = self._flows.get(epsilon)
+        if flow is None:
+            if len(self._flows) > 8:
+                self._flows.clear()
+            flow = self._flows[epsilon] = ExactFlow(self.system, epsilon)
+        return flow
+
+    def initial_guess(self, epsilon: float) -> np.ndarray:
+        """Unknowns of the linear mode j with the requested amplitude (period 2π/λ_j)."""
+        x0, _ = self._guess_amplitude(_check_epsilon(epsilon))
+        period = _TWO_PI / self.linear_frequency
+        if self.formulation == "symmetric":
+            return np.r_[x0, period]
+        return np.r_[x0, np.zeros(self.n), period]
+
+    def split(self, unknowns: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+        """(X0, X1, T) from the unknown vector."""
+        unknowns = np.asarray(unknowns, dtype=float)
+        n = self.n
+        if self.formulation == "symmetric":
+            return unknowns[:n], np.zeros(n), float(unknowns[n])
+        return unknowns[:n], unknowns[n:2 * n], float(unknowns[2 * n])
+
+    def _amplitude_row(
+        self, x0: np.ndarray, v0: np.ndarray, epsilon: float, amplitude: _Amplitude
+    ) -> tuple[float, np.ndarray, np.ndarray, float]:
+        """(value − target, ∂/∂X0, ∂/∂X1, ∂/∂ε) of the amplitude equation (unscaled)."""
+        if amplitude.kind == "modal_amplitude":
+            return float(self.modal_row @ x0) - amplitude.value, self.modal_row, np.zeros(self.n), 0.0
+        grad_x, grad_v, d_eps = _energy_gradient(self.system, x0, v0, epsilon)
+        value = nnm_energy(self.system, x0, v0, epsilon) - amplitude.target(epsilon)
+        return value, grad_x, grad_v, d_eps - amplitude.d_target_d_epsilon()
+
+    def evaluate(self, unknowns: Any, epsilon: float, *, jacobian: bool = True, d_epsilon: bool = False,
+                 amplitude: _Amplitude | None = None) -> dict[str, Any]:
+        """Residual (scaled) and, optionally, its exact Jacobian; one flow integration.
+
+        Returns a dict with ``residual`` (rows scaled), ``jacobian`` (rows
+        scaled, columns = unscaled unknowns), ``d_epsilon`` (∂residual/∂ε),
+        ``d_level`` (∂residual/∂amplitude value), ``success``, ``message``,
+        ``n_switches``.
+        """
+        epsilon = _check_epsilon(epsilon)
+        amplitude = amplitude or self.amplitude
+        x0, v0, period = self.split(unknowns)
+        n = self.n
+        if not (math.isfinite(period) and period > 0) or not (np.all(np.isfinite(x0)) and np.all(np.isfinite(v0))):
+            return {"success": False, "message": f"the iterate left the admissible set (T = {period:.6g})"}
+        horizon = 0.5 * period if self.formulation == "symmetric" else period
+        self.flow_evaluations += 1
+        trajectory = _integrate(self._flow(epsilon), x0, v0, horizon, sensitivity=jacobian, d_epsilon=d_epsilon)
+        if not trajectory.success:
+            return {"success": False, "message": trajectory.message}
+        amp_value, amp_x, amp_v, amp_eps = self._amplitude_row(x0, v0, epsilon, amplitude)
+        xs, vs, As = self.position_scale, self.velocity_scale, self.amplitude_scale
+        if self.formulation == "symmetric":
+            residual = np.r_[trajectory.velocity / vs, amp_value / As]
+        else:
+            residual = np.r_[
+                (trajectory.position - x0) / xs,
+                (trajectory.velocity - v0) / vs,
+                amp_value / As,
+                float(self.modal_row @ v0) / vs,
+            ]
+        out: dict[str, Any] = {"success": True, "message": "", "residual": residual, "n_switches": trajectory.n_switches,
+                               "end_position": trajectory.position, "end_velocity": trajectory.velocity}
+        if jacobian or d_epsilon:
+            acceleration = self.system.acceleration(trajectory.position, epsilon)
+        if jacobian:
+            S = trajectory.sensitivity
+            if self.formulation == "symmetric":
+                J = np.zeros((n + 1, n + 1))
+                J[:n, :n] = S[n:, :n] / vs
+                J[:n, n] = 0.5 * acceleration / vs
+                J[n, :n] = amp_x / As
+            else:
+                identity = np.eye(n)
+                J = np.zeros((2 * n + 2, 2 * n + 1))
+                J[:n, :n] = (S[:n, :n] - identity) / xs
+                J[:n, n:2 * n] = S[:n, n:] / xs
+                J[:n, 2 * n] = trajectory.velocity / xs
+                J[n:2 * n, :n] = S[n:, :n] / vs
+                J[n:2 * n, n:2 * n] = (S[n:, n:] - identity) / vs
+                J[n:2 * n, 2 * n] = acceleration / vs
+                J[2 * n, :n] = amp_x / As
+                J[2 * n, n:2 * n] = amp_v / As
+                J[2 * n + 1, n:2 * n] = self.modal_row / vs
+            out["jacobian"] = J
+        if d_epsilon:
+            dz = trajectory.d_epsilon
+            if self.formulation == "symmetric":
+                out["d_epsilon"] = np.r_[dz[n:] / vs, amp_eps / As]
+            else:
+                out["d_epsilon"] = np.r_[dz[:n] / xs, dz[n:] / vs, amp_eps / As, 0.0]
+        level_row = -amplitude.d_target_d_value(epsilon) / As
+        out["d_level"] = np.r_[np.zeros(len(residual) - (1 if self.formulation == "symmetric" else 2)), level_row,
+                               np.zeros(0 if self.formulation == "symmetric" else 1)]
+        return out
+
+    def residual(self, unknowns: Any, epsilon: float) -> np.ndarray:
+        """Scaled residual vector (raises ConvergenceError if the flow fails)."""
+        out = self.evaluate(unknowns, epsilon, jacobian=False)
+        if not out["success"]:
+            raise ConvergenceError(out["message"])
+        return out["residual"]
+
+    def jacobian(self, unknowns: Any, epsilon: float) -> tuple[np.ndarray, np.ndarray]:
+        """Exact Jacobian of :meth:`residual` in the unknowns, and the column ∂residual/∂ε."""
+        out = self.evaluate(unknowns, epsilon, jacobian=True, d_epsilon=True)
+        if not out["success"]:
+            raise ConvergenceError(out["message"])
+        return out["jacobian"], out["d_epsilon"]
+
+    # ------------------------------------------------------------ verification
+    def mode_share(self, x0: np.ndarray, v0: np.ndarray) -> tuple[float, int]:
+        """Share of mode j in the linear modal energies of (x0, v0), and the dominant mode (1-based)."""
+        frequencies = self.system.modes().frequencies
+        modal_energy = 0.5 * ((self.projector @ v0) ** 2 + (frequencies * (self.projector @ x0)) ** 2)
+        total = float(np.sum(modal_energy))
+        if not total > 0:
+            return 1.0, self.mode
+        return float(modal_energy[self.mode - 1] / total), int(np.argmax(modal_energy)) + 1
+
+    def verify(self, unknowns: np.ndarray, epsilon: float, *, verify_tol: float, stability_tol: float,
+               iterations: int, amplitude: _Amplitude | None = None, formulation_label: str | None = None,
+               min_mode_share: float | None = None, note: str = "") -> NNMResult:
+        """One flow over the full period: periodicity residual, monodromy, Floquet multipliers.
+
+        With ``min_mode_share``, an orbit whose mode-j share of the modal
+        energy is below it is reported as a failure (Newton from a distant
+        guess can land on another periodic orbit, e.g. a resonant one).
+        """
+        amplitude = amplitude or self.amplitude
+        label = formulation_label or self.formulation
+        x0, v0, period = self.split(unknowns)
+        n = self.n
+        if not (math.isfinite(period) and period > 0):
+            return _failed(self.mode, epsilon, self.linear_frequency, n, f"invalid period T = {period}", label,
+                           iterations, self.flow_evaluations, x0)
+        self.flow_evaluations += 1
+        trajectory = _integrate(self._flow(epsilon), x0, v0, period, sensitivity=True, d_epsilon=False)
+        if not trajectory.success:
+            return _failed(self.mode, epsilon, self.linear_frequency, n, trajectory.message, label, iterations,
+                           self.flow_evaluations, x0)
+        frequency = _TWO_PI / period
+        scale = max(float(np.max(np.abs(x0))), float(np.max(np.abs(v0))) / frequency, np.finfo(float).tiny)
+        residual = max(
+            float(np.max(np.abs(trajectory.position - x0))) / scale,
+            float(np.max(np.abs(trajectory.velocity - v0))) / (frequency * scale),
+        )
+        amp_value, _, _, _ = self._amplitude_row(x0, v0, epsilon, amplitude)
+        amp_scale = max(abs(amplitude.target(epsilon)), self.amplitude_scale, np.finfo(float).tiny)
+        amplitude_error = abs(amp_value) / amp_scale
+        monodromy = trajectory.sensitivity
+        multipliers = np.linalg.eigvals(monodromy)
+        multipliers = multipliers[np.argsort(np.abs(multipliers - 1.0), kind="stable")]
+        stable = bool(np.max(np.abs(multipliers)) <= 1.0 + stability_tol)
+        energy = nnm_energy(self.system, x0, v0, epsilon)
+        share, dominant = self.mode_share(x0, v0)
+        common = dict(
+            mode=self.mode, epsilon=epsilon, frequency=frequency, period=period,
+            linear_frequency=self.linear_frequency, release_position=np.array(x0), release_velocity=np.array(v0),
+            modal_coordinates=self.projector @ x0, energy=energy, floquet_multipliers=multipliers, stable=stable,
+            residual=residual, n_switches=trajectory.n_switches, mode_share=share, formulation=label,
+            newton_iterations=iterations,
+            flow_evaluations=self.flow_evaluations, monodromy=monodromy,
+        )
+        if not (residual <= verify_tol and amplitude_error <= verify_tol):
+            return NNMResult(
+                success=False,
+                message=(
+                    f"verification failed: periodicity residual {residual:.2e}, amplitude residual "
+                    f"{amplitude_error:.2e} over one full period (verify_tol = {verify_tol:.1e}){note}"
+                ),
+                **common,
+            )
+        if min_mode_share is not None and share < min_mode_share:
+            return NNMResult(
+                success=False,
+                message=(
+                    f"converged to a periodic orbit that is not the NNM of mode {self.mode}: mode {dominant} carries "
+                    f"the most modal energy, mode {self.mode} only {share:.1%} (< {min_mode_share:.0%}); start closer "
+                    "(continue_nnm from the linear mode, or initial_guess=)"
+                ),
+                **common,
+            )
+        contact = "" if trajectory.n_switches else "; no contact along the orbit: it is the linear mode (ω = λ_j)"
+        return NNMResult(
+            success=True,
+            message=f"converged in {iterations} iterations, verified residual {residual:.1e}{contact}{note}",
+            **common,
+        )
+
+
+# --------------------------------------------------------------------------- #
+# Newton
+# --------------------------------------------------------------------------- #
+@dataclass
+class _NewtonOutcome:
+    success: bool
+    message: str
+    unknowns: np.ndarray
+    iterations: int
+    last: dict[str, Any] | None = None
+
+
+def _scaled_solve(matrix: np.ndarray, rhs: np.ndarray, columns: np.ndarray) -> tuple[np.ndarray | None, float]:
+    """Least-squares solve of matrix·Δ = rhs with column scaling; (Δ, σ_min/σ_max)."""
+    scaled = matrix * columns[None, :]
+    if not np.all(np.isfinite(scaled)):
+        return None, 0.0
+    singular_values = np.linalg.svd(scaled, compute_uv=False)
+    ratio = float(singular_values[-1] / singular_values[0]) if singular_values[0] > 0 else 0.0
+    if ratio < _SINGULAR_RATIO:
+        return None, ratio
+    step = np.linalg.lstsq(scaled, rhs, rcond=None)[0]
+    return step * columns, ratio
+
+
+def _newton(
+    evaluate: Callable[[np.ndarray], dict[str, Any]],
+    unknowns: np.ndarray,
+    columns: np.ndarray,
+    *,
+    tol: float,
+    max_iterations: int,
+    jacobian_key: str = "jacobian",
+    step_tol: float = _STEP_TOL,
+    max_backtracks: int = 5,
+) -> _NewtonOutcome:
+    """Damped (Gauss–)Newton on the scaled residual.
+
+    Stops when the residual is ≤ tol, or when a full Newton step is ≤ step_tol
+    (scaled): quadratic convergence then puts the residual of ``z + Δ`` far
+    below tol, and the caller verifies that final state with a full-period
+    flow, so it is not evaluated here (one flow saved per solve).  ``last`` is
+    the last evaluation (its Jacobian serves for the continuation tangent).
+    """
+    z = np.array(unknowns, dtype=float)
+    current = evaluate(z)
+    if not current["success"]:
+        return _NewtonOutcome(False, current["message"], z, 0, None)
+    norm = float(np.max(np.abs(current["residual"])))
+    for iteration in range(1, max_iterations + 1):
+        if norm <= tol:
+            return _NewtonOutcome(True, f"residual {norm:.1e}", z, iteration - 1, current)
+        step, ratio = _scaled_solve(current[jacobian_key], -current["residual"], columns)
+        if step is None:
+            return _NewtonOutcome(
+                False,
+                f"singular Jacobian (σ_min/σ_max = {ratio:.1e}) at iteration {iteration}, residual {norm:.1e}: a fold "
+                "of the branch in this parameter, a bifurcation (internal resonance λ_k/ω ∈ ℤ) or a degenerate "
+                "amplitude — continue the branch with pseudo-arclength (continue_nnm) or change the parameter",
+                z, iteration, current,
+            )
+        size = float(np.max(np.abs(step / columns)))
+        if size <= step_tol:
+            return _NewtonOutcome(True, f"residual {norm:.1e}, last step {size:.1e}", z + step, iteration, current)
+        damping = 1.0
+        for _ in range(max_backtracks + 1):
+            trial = z + damping * step
+            candidate = evaluate(trial)
+            if candidate["success"]:
+                trial_norm = float(np.max(np.abs(candidate["residual"])))
+                if trial_norm < norm or trial_norm <= tol:
+                    break
+            damping *= 0.5
+        else:
+            return _NewtonOutcome(
+                False,
+                f"no convergence: no Newton step decreased the residual at iteration {iteration} "
+                f"(residual {norm:.1e}; last: {candidate.get('message') or 'larger residual'})",
+                z, iteration, current,
+            )
+        z, current, norm = trial, candidate, trial_norm
+    if norm <= tol:
+        return _NewtonOutcome(True, f"residual {norm:.1e}", z, max_iterations, current)
+    return _NewtonOutcome(False, f"no convergence in {max_iterations} Newton iterations (residual {norm:.1e})", z,
+                          max_iterations, current)
+
+
+def _impossible_amplitude(problem: NNMShooting, epsilon: float, amplitude: _Amplitude) -> str | None:
+    if amplitude.kind == "modal_amplitude":
+        equilibrium = _equilibrium(problem.system, epsilon)
+        if amplitude.value == float(problem.modal_row @ equilibrium):
+            return (f"impossible amplitude: u_j(0) = {amplitude.value:g} is the equilibrium's, so the orbit is the "
+                    "rest state; give a non-zero modal amplitude")
+        return None
+    floor = nnm_energy(problem.system, _equilibrium(problem.system, epsilon), np.zeros(problem.n), epsilon)
+    target = amplitude.target(epsilon)
+    if not target > floor:
+        return (f"impossible energy: the target E = {target:.6g} is not above the minimum {floor:.6g} (the static "
+                "equilibrium), so no periodic orbit has it; give a larger energy")
+    return None
+
+
+def _guess_unknowns(problem: NNMShooting, epsilon: float, initial_guess: Any) -> np.ndarray:
+    if initial_guess is None:
+        return problem.initial_guess(epsilon)
+    if isinstance(initial_guess, NNMResult):
+        if not initial_guess.success:
+            raise ProblemError("initial_guess is a failed NNMResult; pass a successful one or None")
+        x0, v0, period = initial_guess.release_position, initial_guess.release_velocity, initial_guess.period
+    else:
+        try:
+            x0, period = initial_guess
+        except (TypeError, ValueError):
+            raise ProblemError("initial_guess must be an NNMResult, a pair (X0, T) or None") from None
+        v0 = np.zeros(problem.n)
+    x0 = np.asarray(x0, dtype=float).reshape(problem.n)
+    if problem.formulation == "symmetric":
+        return np.r_[x0, float(period)]
+    return np.r_[x0, np.asarray(v0, dtype=float).reshape(problem.n), float(period)]
+
+
+def nnm_point(
+    system: UnilateralSystem,
+    epsilon: float,
+    mode: int,
+    *,
+    energy: float | None = None,
+    modal_amplitude: float | None = None,
+    energy_per_epsilon: float | None = None,
+    formulation: str = "symmetric",
+    initial_guess: Any = None,
+    release_sign: int = 1,
+    tol: float = 1e-11,
+    verify_tol: float = 1e-8,
+    stability_tol: float = 1e-6,
+    max_iterations: int = 30,
+    min_mode_share: float | None = 0.5,
+) -> NNMResult:
+    """The NNM of ``mode`` at one ε and one amplitude, by Newton shooting on the exact flow.
+
+    Parameters
+    ----------
+    system : UnilateralSystem
+    epsilon : float
+    mode : int
+        1-based mode number j (1 = lowest λ).
+    energy, modal_amplitude, energy_per_epsilon : float
+        Exactly one amplitude condition (see the module docstring).
+    formulation : {"symmetric", "full"}
+        Half-period form for orbits released from rest (default) or the
+        seed's full-period form with the phase condition ``φ_jᵀ M X'(0) = 0``.
+    initial_guess : NNMResult or (X0, T), optional
+        Default: the linear mode j with the requested amplitude, T = 2π/λ_j.
+    release_sign : {1, -1}
+        Energy amplitudes: release on the ``+φ_j`` or ``−φ_j`` side.
+    tol : float
+        Newton tolerance on the scaled residual (and on the scaled step).
+    verify_tol : float
+        Tolerance of the full-period verification of the final state.
+    stability_tol : float
+        Multipliers with ``|μ| > 1 + stability_tol`` make the orbit unstable.
+    max_iterations : int
+    min_mode_share : float or None
+        Reject an orbit whose share of mode j in the modal energy is below
+        this (default 0.5): Newton from a distant guess may converge to
+        another periodic orbit.  None disables the check.
+
+    Returns
+    -------
+    NNMResult
+        ``success`` is False (with the reason in ``message``) on an impossible
+        energy, a singular Jacobian, no convergence, a flow failure or a failed
+        verification; no exception is raised for those.
+
+    Examples
+    --------
+    The one-dof bilinear oscillator ``u'' + u + ε u_+ = 0`` has
+    ``ω = 2 ω_c / (1 + ω_c)``, ``ω_c = sqrt(1 + ε)``:
+
+    >>> result = nnm_point(UnilateralSystem.one_dof(1), 0.5, 1, modal_amplitude=1.0)
+    >>> result.success, round(result.frequency, 12), round(2 * 1.5**0.5 / (1 + 1.5**0.5), 12)
+    (True, 1.101020514434, 1.101020514434)
+    >>> result.stable, result.n_switches
+    (True, 2)
+    """
+    problem = NNMShooting(system, mode, energy=energy, modal_amplitude=modal_amplitude,
+                          energy_per_epsilon=energy_per_epsilon, formulation=formulation, release_sign=release_sign)
+    epsilon = _check_epsilon(epsilon)
+    n = system.n_dof
+    impossible = _impossible_amplitude(problem, epsilon, problem.amplitude)
+    if impossible:
+        return _failed(problem.mode, epsilon, problem.linear_frequency, n, impossible, formulation, 0, 0)
+    z0 = _guess_unknowns(problem, epsilon, initial_guess)
+    x_guess, _, period_guess = problem.split(z0)
+    problem.set_scales(epsilon, x_guess if np.max(np.abs(x_guess)) > 0 else None, period_guess)
+    outcome = _newton(lambda z: problem.evaluate(z, epsilon), z0, problem.column_scales(), tol=tol,
+                      max_iterations=max_iterations)
+    if not outcome.success:
+        return _failed(problem.mode, epsilon, problem.linear_frequency, n, outcome.message, formulation,
+                       outcome.iterations, problem.flow_evaluations, problem.split(outcome.unknowns)[0])
+    return problem.verify(outcome.unknowns, epsilon, verify_tol=verify_tol, stability_tol=stability_tol,
+                          iterations=outcome.iterations, min_mode_share=min_mode_share)
+
