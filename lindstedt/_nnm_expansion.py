@@ -700,7 +700,8 @@ def release_amplitudes_by_series(system: UnilateralSystem, mode: int, a0: Any, *
     list of (value, error_estimate)
         One pair per mode k ≠ j, in increasing mode order.
     """
-    from ._contact_fourier import contact_ramp_coefficient_mp, series_sum
+    from .algebra.fourier import contact_ramp_coefficient_mp
+    from .algebra.series import series_sum
 
     modes = system.modes()
     frequencies, shapes = modes.frequencies, modes.shapes

@@ -39,21 +39,17 @@ cos(s)/8 - cos(3*s)/8
 2/(3*pi)
 """
 
-from .._contact_fourier import (
-    SeriesEstimate,
+from .fourier import (
     contact_angle,
-    contact_angle_float,
     contact_ramp_coefficient,
     contact_ramp_coefficient_mp,
-    contact_ramp_coefficients_float,
     contact_step_coefficient,
     contact_step_coefficient_mp,
-    contact_step_coefficients_float,
     ramp_times_cosine_coefficient,
-    series_sum,
     step_times_cosine_coefficient,
-    sum_cosine_series_at,
 )
+from .fourier_float import contact_angle_float, contact_ramp_coefficients_float, contact_step_coefficients_float
+from .series import SeriesEstimate, series_sum, sum_cosine_series_at
 from .._cosine import CosineSeries, SecularTermError, SineSeries, solve_harmonic_oscillator
 
 __all__ = [
