@@ -410,3 +410,12 @@ def test_twenty_dof_branch_arclength_needs_ten_times_fewer_flows_than_the_seed_a
     for branch in (arclength, seed):
         exact = [bilinear_frequency(lam[0], e * phi[0, 0]) for e in branch.epsilons]
         np.testing.assert_allclose(branch.frequencies, exact, rtol=1e-11, atol=0)
+
+
+def test_natural_continuation_stops_with_a_reason_where_the_step_collapses():
+    # past eps ~ 6 the seed's 5-dof example has no vibrating contact state: accepted points kept resetting the
+    # halving count, the step shrank until two accepted values coincided and the secant guess divided by zero
+    branch = continue_nnm(seed_example_system(5), 1, method="natural", formulation="full", energy=0.5, start=0.5, stop=20, step=0.5)
+    assert not branch.success and "below min_step" in branch.stop_reason
+    assert all(point.success for point in branch.points)
+    assert branch.epsilons[-1] < 6.1

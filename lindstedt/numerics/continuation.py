@@ -340,10 +340,12 @@ class _Natural(_Stepper):
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.halvings = 0
+        min_step = kwargs.get("min_step")
+        self.h_min = abs(min_step) if min_step else self.step / 2.0**self.max_halvings
 
     def guess(self, points: list[NNMResult], values: list[float], target: float) -> np.ndarray:
         guess = _unknowns_of(self.problem, points[-1])
-        if len(points) >= 2:  # secant extrapolation
+        if len(points) >= 2 and values[-1] != values[-2]:  # secant extrapolation
             previous = _unknowns_of(self.problem, points[-2])
             fraction = (target - values[-1]) / (values[-1] - values[-2])
             guess = guess + fraction * (guess - previous)
@@ -366,6 +368,9 @@ class _Natural(_Stepper):
         self.step *= 0.5
         if self.halvings > self.max_halvings:
             return (f"step halved {self.max_halvings} times without convergence at {self.label} = "
+                    f"{attempt.value:.6g}: {attempt.reason}")
+        if self.step < self.h_min:  # accepted points reset the halvings: the step itself is bounded below
+            return (f"step size {self.step:.2e} below min_step {self.h_min:.2e} at {self.label} = "
                     f"{attempt.value:.6g}: {attempt.reason}")
         return None
 
