@@ -220,13 +220,13 @@ def test_nan_gap_raises(symbolic_gap: Expansion) -> None:
 def test_values_are_validated_once_per_values(monkeypatch: pytest.MonkeyPatch) -> None:
     expansion = lindstedt.expand("Max(0, u - 1/2)", order=1)
     calls = []
-    original = Expansion._validated
+    original = lindstedt.Oscillator.numeric_substitution
 
-    def counting(self, substitution):
-        calls.append(dict(substitution))
-        return original(self, substitution)
+    def counting(self, values=None):  # the values are read (and then checked) only on a cache miss
+        calls.append(dict(values or {}))
+        return original(self, values)
 
-    monkeypatch.setattr(Expansion, "_validated", counting)
+    monkeypatch.setattr(lindstedt.Oscillator, "numeric_substitution", counting)
     values = {"a0": 1, "omega0": 1}
     for _ in range(3):
         expansion.frequency(0.1, values=values)
