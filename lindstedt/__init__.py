@@ -21,7 +21,7 @@ Examples
 """
 
 from ._all_modes import AllModesFirstOrder, all_modes_first_order
-from ._api import cache_info, clear_cache, expand
+from ._lindstedt_poincare import LindstedtPoincare, cache_info, clear_cache, expand
 from ._codegen import CodeGenerationError, GeneratedCode, generate_code
 from ._cosine import CosineSeries, SineSeries, solve_harmonic_oscillator
 from ._errors import (
@@ -35,7 +35,6 @@ from ._errors import (
 )
 from ._expansion import Expansion, ExpansionValidityWarning, PiecewiseWaveform, Waveform
 from ._flow import ExactFlow
-from ._hierarchy import LindstedtPoincare
 from ._nnm_expansion import NNMExpansion, NNMProblem, StrainedCoordinatesNNM, nnm
 from .numerics import NNMBranch, NNMResult, continue_nnm, nnm_point, nnm_sweep, seed_example_system
 from ._problem import Oscillator

@@ -20,7 +20,7 @@ import numpy as np
 import sympy
 from scipy.integrate import solve_ivp
 
-from ._api import expand
+from ._lindstedt_poincare import expand
 from ._reference_duffing import duffing_frequency_taylor
 from ._reference_piecewise import piecewise_linear_frequency_taylor, piecewise_linear_frequency_taylor_symbolic
 from ._svg import line_plot_svg

@@ -38,31 +38,19 @@ and only the ``cos s`` coefficient of ``F_{k−1}``.
 from __future__ import annotations
 
 import math
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass
-from typing import Any, Callable, ClassVar, Hashable, NamedTuple
+from typing import Any, Callable, ClassVar
 
 import mpmath
 import sympy
 from sympy import QQ, RealField
 
 from ._cosine import CosineSeries, solve_harmonic_oscillator, sum_series
-from ._errors import OrderError, ProblemError, UnsupportedNonlinearityError
+from ._errors import UnsupportedNonlinearityError
 from ._problem import DISPLACEMENT, Oscillator
 from ._series_algebra import extend_square_root
 
-__all__ = [
-    "CACHE_MAXSIZE",
-    "CacheInfo",
-    "LindstedtPoincare",
-    "MAX_ORDER",
-    "NormalForm",
-    "SmoothHierarchy",
-    "cache_info",
-    "clear_cache",
-    "normal_form",
-]
+__all__ = ["MAX_ORDER", "NormalForm", "SmoothHierarchy", "normal_form"]
 
 MAX_ORDER = 100
 _MAX_CHEBYSHEV_NODES = 512
@@ -383,195 +371,3 @@ class SmoothHierarchy:
                 solution = solve_harmonic_oscillator(right_hand_side, self._domain.one, first_harmonic=self._domain.zero)
             self._waveforms.append(self._prune(solution))
         return self._waveforms[order]
-
-
-#: Most hierarchies kept by the process-wide cache (least recently used evicted first).
-CACHE_MAXSIZE = 64
-
-
-class CacheInfo(NamedTuple):
-    """Statistics of the hierarchy cache (see :func:`cache_info`)."""
-
-    hits: int
-    misses: int
-    size: int
-    maxsize: int
-
-
-class _HierarchyCache:
-    """Process-wide LRU store of hierarchies, keyed by a canonical description of problem and method.
-
-    A hierarchy is lazy and only ever grows (orders are appended, never
-    changed), so one object serves every expansion of its problem: a higher
-    order reuses the lower ones, a lower order reads them.
-    """
-
-    def __init__(self, maxsize: int):
-        self.maxsize = maxsize
-        self._entries: OrderedDict[Hashable, Any] = OrderedDict()
-        self._lock = threading.Lock()
-        self.hits = 0
-        self.misses = 0
-
-    def get(self, key: Hashable, build: Callable[[], Any]) -> Any:
-        with self._lock:
-            if key in self._entries:
-                self._entries.move_to_end(key)
-                self.hits += 1
-                return self._entries[key]
-            self.misses += 1
-        value = build()  # outside the lock: building may raise, and must not block other problems
-        with self._lock:
-            value = self._entries.setdefault(key, value)  # another thread may have built it meanwhile
-            self._entries.move_to_end(key)
-            while len(self._entries) > self.maxsize:
-                self._entries.popitem(last=False)
-        return value
-
-    def clear(self) -> None:
-        with self._lock:
-            self._entries.clear()
-            self.hits = self.misses = 0
-
-    def info(self) -> CacheInfo:
-        with self._lock:
-            return CacheInfo(self.hits, self.misses, len(self._entries), self.maxsize)
-
-
-_CACHE = _HierarchyCache(CACHE_MAXSIZE)
-
-
-def clear_cache() -> None:
-    """Forget every cached hierarchy (and reset the statistics of :func:`cache_info`).
-
-    ``lindstedt.expand`` keeps the hierarchies of the last :data:`CACHE_MAXSIZE`
-    (64) problems, so that asking again, or to a higher order, reuses the work
-    done.  Results are the same with or without the cache; clearing frees the
-    memory and makes the next expansion start from scratch (e.g. for timing).
-
-    Examples
-    --------
-    >>> import lindstedt
-    >>> lindstedt.clear_cache()
-    >>> lindstedt.cache_info()
-    CacheInfo(hits=0, misses=0, size=0, maxsize=64)
-    >>> _ = lindstedt.expand("u**3", order=2, a0=1, omega0=1)
-    >>> _ = lindstedt.expand("u**3", order=4, a0=1, omega0=1)
-    >>> lindstedt.cache_info()
-    CacheInfo(hits=1, misses=1, size=1, maxsize=64)
-    >>> lindstedt.clear_cache()
-    >>> lindstedt.cache_info().size
-    0
-    """
-    _CACHE.clear()
-
-
-def cache_info() -> CacheInfo:
-    """Hits, misses, current size and maximum size of the hierarchy cache (see :func:`clear_cache`).
-
-    Examples
-    --------
-    >>> import lindstedt
-    >>> lindstedt.cache_info().maxsize
-    64
-    """
-    return _CACHE.info()
-
-
-def _problem_key(problem: Oscillator) -> tuple:
-    """Canonical, hashable description of ``problem``: exact sympy data in the problem's fixed symbols.
-
-    Parameters are sorted by name (their declaration order does not change the problem).
-    """
-    params = tuple(sorted(problem.params, key=lambda item: item[0].name))
-    return (problem.f, problem.a0, problem.omega0, params, problem.normalization)
-
-
-class LindstedtPoincare:
-    """The method of strained coordinates (Lindstedt–Poincaré) for one oscillator.
-
-    One verb: :meth:`expand`.  The hierarchy behind it is cached (process-wide,
-    the last :data:`CACHE_MAXSIZE` problems, see :func:`clear_cache`), so
-    expanding the same problem again, or to a higher order, reuses all the work
-    already done.
-
-    Parameters
-    ----------
-    precision : int
-        Decimal digits for non-polynomial (analytic) f, whose expansion is
-        numeric, and for ``numeric=True``.  Polynomial f is always exact.
-    numeric : bool
-        Piecewise-linear f: compute in a ``RealField`` of ``precision`` digits
-        (fast) instead of exactly.  Floats in the input also select it.
-
-    Examples
-    --------
-    >>> from lindstedt._problem import Oscillator
-    >>> method = LindstedtPoincare()
-    >>> method.expand(Oscillator("u**3", a0=1, omega0=1), order=2).omega
-    (1, 3/8, -21/256)
-    """
-
-    def __init__(self, precision: int = 30, numeric: bool = False):
-        if not isinstance(precision, int) or precision < 15 or precision > 1000:
-            raise ProblemError("precision must be an integer number of decimal digits between 15 and 1000")
-        self.precision = precision
-        self.numeric = bool(numeric)
-
-    def hierarchy(self, problem: Oscillator, order: int = 4):
-        """The (cached) normalised hierarchy of ``problem`` (smooth or piecewise-linear).
-
-        ``order`` is the highest order that will be asked for; float hierarchies
-        of piecewise problems near grazing add guard digits for it.
-
-        The cache key is the problem's exact data (:func:`_problem_key`) and what
-        of the method's settings the hierarchy depends on: the working digits of
-        a float hierarchy, ``precision`` for non-polynomial smooth f.
-        """
-        problem_key = _problem_key(problem)
-        if problem.is_non_smooth:
-            from ._piecewise_hierarchy import PiecewiseHierarchy, piecewise_normal_form
-
-            if not self.numeric:  # the problem's numbers are exact (the parser reads floats exactly)
-                # Exact: the normal form does not depend on the order; it is built only on a miss
-                # (its domain has fresh Dummy generators and must not enter the key).
-                return _CACHE.get(
-                    (problem_key, "piecewise", None),
-                    lambda: PiecewiseHierarchy(piecewise_normal_form(problem, None), problem.normalization),
-                )
-            # Float: the working digits (precision + guard digits near grazing, which grow with
-            # the order) decide the hierarchy; the float normal form is cheap, build it to know them.
-            form = piecewise_normal_form(problem, self.precision, order_hint=order + 1)
-            digits = form.domain.dps if form.prune_tolerance is not None else None
-            return _CACHE.get((problem_key, "piecewise", digits), lambda: PiecewiseHierarchy(form, problem.normalization))
-        digits = None if problem.is_polynomial else self.precision
-        return _CACHE.get(
-            (problem_key, "smooth", digits),
-            lambda: SmoothHierarchy(normal_form(problem, self.precision), problem.normalization),
-        )
-
-    def expand(self, problem: Oscillator, order: int):
-        """Lindstedt–Poincaré expansion of ``problem`` to ``order``.
-
-        Returns
-        -------
-        Expansion
-            Lazy, frozen result; nothing beyond the requested quantities is computed.
-        """
-        from ._expansion import Expansion
-
-        validate_order(order)
-        return Expansion(problem=problem, order=order, _hierarchy=self.hierarchy(problem, order))
-
-
-def validate_order(order: Any) -> int:
-    """Check that ``order`` is an integer in [0, MAX_ORDER]."""
-    if isinstance(order, bool) or not isinstance(order, int):
-        raise OrderError(f"order must be an integer, got {order!r}")
-    if order < 0:
-        raise OrderError(f"order must be >= 0, got {order}")
-    if order > MAX_ORDER:
-        raise OrderError(
-            f"order {order} is above the limit {MAX_ORDER}: the cost grows like order^4; ask for at most {MAX_ORDER}"
-        )
-    return order

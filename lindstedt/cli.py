@@ -116,7 +116,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _command_expand(arguments: argparse.Namespace) -> str:
-    from ._api import expand
+    from ._lindstedt_poincare import expand
 
     expansion = expand(
         arguments.f,
