@@ -39,7 +39,17 @@ closed form (relative accuracy 4 machine epsilons).  A tangency
 ``g = g' = 0`` is not a switch.  At ``t = 0`` and after every switch, a spring
 sitting on its switching surface (``|g| ≤`` rounding) is put in the state it is
 moving into, decided by the sign of ``g'``, then ``g''`` (both are the same in
-either state because the force ``(·)_+`` is continuous).
+either state because the force ``(·)_+`` is continuous).  The search of an arc
+that starts on a spring's surface (``|h(0)| ≤ δ``) looks for the next switch
+strictly after the start: ``τ = 0`` is the switch just made, never a bracket
+end.  It resumes at the first instant a minorant certifies to be clearly on
+the new side (``h > δ`` there, ``h > −δ`` before): ``h'(0)/G2`` when moving in
+(``h'(0) > 0``), ``2 h''(0)/G3`` for a grazing entry (``h'' > 0``).  (Otherwise
+the first step may cross a whole shallow excursion, from ``τ = 0`` to beyond its
+exit, and the root solve of the bracket ``[0, step]`` returns the start again:
+the flow would switch in and out at one instant.)  If neither certifies, the
+motion onto the new side is itself at rounding level (a graze): ``τ = 0`` is
+then a bracket end only if ``h`` is already leaving (``h(0) ≥ 0 > h'(0)``).
 
 Precision.  The modal decompositions (for ``W = Aᵀ``: refined by an
 Ogita–Aishima iteration), the equilibria, the state carried from arc to arc
@@ -448,6 +458,33 @@ class _Bracket:
         )
 
 
+def _leave_surface(value: float, slope: float, curvature: float, g2: float, g3: float, band: float) -> float | None:
+    """First instant s > 0 certified clearly on the current side, for h starting on its switching surface.
+
+    With h(0) = value (within the band of 0), h'(0) = slope, h''(0) = curvature
+    and the bounds |h''| ≤ g2, |h'''| ≤ g3, returns s > 0 with h(s) > band
+    (beyond the rounding of h, so h(s) evaluates positive) and h > −band on
+    [0, s] (no excursion is skipped), or None when neither minorant proves it
+    (the motion onto this side is itself at rounding level: a graze):
+
+    * moving in (slope > 0): the quadratic minorant value + slope s − g2 s²/2 is
+      concave, so it is ≥ value on [0, slope/g2], where it reaches
+      value + slope²/(2 g2);
+    * a grazing entry (curvature > 0, slope ≈ 0): the cubic minorant
+      value + slope s + curvature s²/2 − g3 s³/6 is ≥ value + min(slope, 0) s
+      on [0, 2 curvature/g3], where it reaches value + slope s + (2/3) curvature³/g3².
+    """
+    if slope > 0.0:
+        s = slope / g2
+        if value + 0.5 * slope * s > band:
+            return s
+    if curvature > 0.0:
+        s = 2.0 * curvature / g3
+        if value + min(slope, 0.0) * s > -band and value + slope * s + (2.0 / 3.0) * curvature * (curvature / g3) ** 2 > band:
+            return s
+    return None
+
+
 def _first_exit(
     offset: float,
     cos_coefficients: np.ndarray,
@@ -463,6 +500,9 @@ def _first_exit(
     below −band in (0, tau_max].  Returns None when h > −band on the whole of
     [0, tau_max] — certified by the minorants described in the module
     docstring, so no excursion deeper than band is missed.  Requires h(0) > −band.
+    When h(0) ≤ band (the arc starts on the switching surface) the zero at
+    τ = 0 is the switch that started the arc and is excluded (see
+    :func:`_leave_surface`).
     """
     band = max(band, _TINY)
     amplitudes = np.hypot(cos_coefficients, sin_coefficients)
@@ -476,7 +516,23 @@ def _first_exit(
 
     tau = 0.0
     h, h1, h2 = derivatives(tau)
-    last_nonnegative: float | None = 0.0 if h >= 0.0 else None
+    last_nonnegative: float | None = 0.0 if h > band else None
+    if last_nonnegative is None:
+        # h(0) is within the band of the switching surface (an arc started at a switch, or at t = 0 on the
+        # surface): there τ = 0 is the switch just made, so it must not become a bracket end (Brent would
+        # return it, and the flow would switch back and forth at this instant, until max_arcs).  The search
+        # continues from the first instant certified to be clearly on this side, if the motion onto it is
+        # beyond rounding; else τ = 0 is a bracket end only when h is leaving this side (h ≥ 0 > h').
+        start = _leave_surface(h, h1, h2, g2, g3, band)
+        if start is not None:
+            if start >= tau_max:
+                return None
+            tau = start
+            h, h1, h2 = derivatives(tau)
+            if h >= 0.0:
+                last_nonnegative = tau
+        elif h >= 0.0 and h1 < 0.0:
+            last_nonnegative = 0.0
     for _ in range(_MAX_SEARCH_STEPS):
         lifted = h + band
         if lifted <= 0.01 * band:  # reached the far side of the band: an excursion
