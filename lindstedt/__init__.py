@@ -34,7 +34,7 @@ from ._errors import (
     UnsupportedNonlinearityError,
 )
 from ._expansion import Expansion, ExpansionValidityWarning, PiecewiseWaveform, Waveform
-from ._flow import ExactFlow
+from .numerics.flow import ExactFlow
 from ._nnm_expansion import NNMExpansion, NNMProblem, StrainedCoordinatesNNM, nnm
 from .numerics import NNMBranch, NNMResult, continue_nnm, nnm_point, nnm_sweep, seed_example_system
 from ._problem import Oscillator

@@ -31,7 +31,7 @@ Nonlinear normal modes by shooting
 The systems themselves are :class:`lindstedt.UnilateralSystem`.
 
 Layout (the pipeline, in order)
-    the exact flow (:class:`ExactFlow`, in ``lindstedt._flow``) →
+    the exact flow (:class:`ExactFlow`, in :mod:`lindstedt.numerics.flow`; switch search in ``switching``; DOP853 for smooth f in ``smooth``) →
     :mod:`~lindstedt.numerics.sensitivity` (its exact derivatives in the initial
     state and in ε) → :mod:`~lindstedt.numerics.shooting` (the shooting
     residual and Jacobian, Newton, :func:`nnm_point`, :func:`nnm_energy`) →
@@ -54,7 +54,8 @@ Examples
 (True, True)
 """
 
-from .._flow import ExactFlow, FlowMapResult, FlowResult, SwitchEvent, smooth_flow
+from .flow import ExactFlow, FlowMapResult, FlowResult, SwitchEvent
+from .smooth import smooth_flow
 from .continuation import continue_nnm, nnm_sweep
 from .examples import seed_example_system
 from .results import ContinuationProgress, NNMBranch, NNMResult

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from .._errors import ConvergenceError, ProblemError
-from .._flow import ExactFlow
+from .flow import ExactFlow
 from .._parsing import parse_float
 from .._system import UnilateralSystem
 

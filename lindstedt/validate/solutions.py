@@ -37,7 +37,8 @@ from scipy.integrate import solve_ivp
 
 from .._errors import ProblemError, UnsupportedNonlinearityError
 from .._expansion import Expansion
-from .._flow import ExactFlow, FlowResult, smooth_flow
+from ..numerics.flow import ExactFlow, FlowResult
+from ..numerics.smooth import smooth_flow
 from .._piecewise_linear import decompose_piecewise_linear
 from .._problem import DISPLACEMENT, Oscillator
 from .._system import UnilateralSystem
