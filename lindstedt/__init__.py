@@ -23,7 +23,7 @@ Examples
 from ._all_modes import AllModesFirstOrder, all_modes_first_order
 from ._lindstedt_poincare import LindstedtPoincare, cache_info, clear_cache, expand
 from ._codegen import CodeGenerationError, GeneratedCode, generate_code
-from ._cosine import CosineSeries, SineSeries, solve_harmonic_oscillator
+from .algebra.cosine import CosineSeries, SineSeries, solve_harmonic_oscillator
 from ._errors import (
     ConvergenceError,
     LindstedtError,

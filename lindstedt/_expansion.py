@@ -43,7 +43,7 @@ import sympy
 
 from ._assumptions import DerivationAssumptions, shown_values
 from ._errors import OrderError, ParameterError
-from ._branch import Branch, EvaluationPoint, evaluate_float_terms
+from .algebra.branch import Branch, EvaluationPoint, evaluate_float_terms
 from ._hierarchy import MAX_ORDER, SmoothHierarchy
 from ._piecewise_hierarchy import PiecewiseHierarchy
 from ._problem import Oscillator

@@ -45,7 +45,7 @@ import mpmath
 import sympy
 from sympy import QQ, RealField
 
-from ._cosine import CosineSeries, solve_harmonic_oscillator, sum_series
+from .algebra.cosine import CosineSeries, solve_harmonic_oscillator, sum_series
 from ._errors import UnsupportedNonlinearityError
 from ._problem import DISPLACEMENT, Oscillator
 from ._series_algebra import extend_square_root

@@ -46,7 +46,7 @@ import numpy as np
 import sympy
 from sympy import RealField
 
-from ._branch import Branch, EvaluationPoint, evaluate_float_terms
+from .algebra.branch import Branch, EvaluationPoint, evaluate_float_terms
 from ._errors import ProblemError, ResonanceError
 from ._parsing import parse_real
 from ._series_algebra import LazyOrders, shift_powers

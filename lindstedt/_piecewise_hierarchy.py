@@ -12,7 +12,7 @@ crossing is ``s_i*(ε) = β_i + Σ_k σ_{i,k} ε̂^k``.
 **Branches.**  On the piece p of [0, π] between consecutive crossings the
 equation is linear, ``Ω² W'' + (1 + ε̂ ℓ_p) W = −ε̂ m_p``, so the solution is an
 analytic branch ``W^p(s, ε̂) = Σ_k ε̂^k W_k^p(s)`` (quasi-trigonometric, see
-:mod:`lindstedt._branch`), continued analytically past β_i.  Order k gives
+:mod:`lindstedt.algebra.branch`), continued analytically past β_i.  Order k gives
 
     W_k^p'' + W_k^p = A_k cos s − Σ_{i=1}^{k−1} A_i W_{k−i}^p'' − ℓ_p W_{k−1}^p − m_p [k = 1],
 
@@ -41,7 +41,7 @@ import mpmath
 import sympy
 from sympy import QQ, RealField
 
-from ._branch import Branch, EvaluationPoint
+from .algebra.branch import Branch, EvaluationPoint
 from ._errors import ProblemError
 from ._piecewise_linear import decompose_piecewise_linear
 from ._problem import DISPLACEMENT, Oscillator

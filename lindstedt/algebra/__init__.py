@@ -25,6 +25,11 @@ Contact Fourier kernel of a unilateral spring (``κ = b/|a0|``, ``β = arccos κ
     converging series they build (:func:`series_sum`,
     :func:`sum_cosine_series_at`, each a :class:`SeriesEstimate` ``(value, error_estimate)``).
 
+Analytic branches
+    ``Σ c s^m cos(j s) + d s^m sin(j s)`` on one contact state (module
+    :mod:`lindstedt.algebra.branch`): the representation the piecewise engines
+    work in; an internal interface, not re-exported here.
+
 Examples
 --------
 >>> import sympy
@@ -50,7 +55,7 @@ from .fourier import (
 )
 from .fourier_float import contact_angle_float, contact_ramp_coefficients_float, contact_step_coefficients_float
 from .series import SeriesEstimate, series_sum, sum_cosine_series_at
-from .._cosine import CosineSeries, SecularTermError, SineSeries, solve_harmonic_oscillator
+from .cosine import CosineSeries, SecularTermError, SineSeries, solve_harmonic_oscillator
 
 __all__ = [
     "CosineSeries",

@@ -26,7 +26,7 @@ import numpy as np
 import sympy
 from sympy import Rational
 
-from ._errors import LindstedtError
+from .._errors import LindstedtError
 
 __all__ = ["CosineSeries", "SineSeries", "solve_harmonic_oscillator"]
 
