@@ -240,7 +240,7 @@ def generate_code(expansion: Any, quantity: str = "frequency", language: str = "
         vector, expression = TIME, expansion.displacement_expr()
         arguments = [TIME, EPSILON, *parameters]
     # Exact constants (π, acos(1/3), big rationals) become 25-digit floats: compact code, no accuracy lost in doubles.
-    expression = sympy.sympify(expression, strict=True).evalf(25)
+    expression = expression.evalf(25)
     return _generated(language, quantity, arguments, vector, expression)
 
 

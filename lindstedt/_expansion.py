@@ -334,7 +334,7 @@ class Expansion:
 
     def _floats(self, expressions: list[sympy.Expr], values: Mapping[Any, Any] | None) -> np.ndarray:
         substitution = self._substitution(values)
-        return _finite(np.array([_to_float(sympy.sympify(e, strict=True).xreplace(substitution)) for e in expressions], dtype=float), substitution)
+        return _finite(np.array([_to_float(e.xreplace(substitution)) for e in expressions], dtype=float), substitution)
 
     def frequency(self, epsilon: Any, values: Mapping[Any, Any] | None = None, *, order: int | None = None) -> Any:
         """ω(ε) = Σ_{k≤order} ω_k ε^k as float (vectorised over ``epsilon``).

@@ -58,17 +58,13 @@ def _parse_parameters(items: Sequence[str]) -> dict[str, str | None]:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``lindstedt`` command."""
-    from importlib.metadata import PackageNotFoundError, version
+    from . import __version__
 
     parser = _ArgumentParser(
         prog="lindstedt",
         description="Exact Lindstedt-Poincare expansions of u'' + omega0^2 u + eps f(u) = 0, checked against exact references.",
     )
-    try:
-        package_version = version("lindstedt")
-    except PackageNotFoundError:  # pragma: no cover - running from a source tree without installation
-        package_version = "unknown"
-    parser.add_argument("--version", action="version", version=f"lindstedt {package_version}")
+    parser.add_argument("--version", action="version", version=f"lindstedt {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_ArgumentParser)
 
     expand = commands.add_parser("expand", help="expand u'' + omega0^2 u + eps f(u) = 0 to a given order")

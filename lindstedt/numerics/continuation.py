@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import math
 import time
+from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterable
 from concurrent.futures import Executor
 from dataclasses import dataclass
@@ -294,7 +295,7 @@ def _drive(stepper: _Stepper, start: float, stop: float, max_points: int,
         stepper.accept(attempt)
 
 
-class _Stepper:
+class _Stepper(ABC):
     """A continuation method: the first point and how to step from the last accepted one.
 
     ``step`` is the current step (reported in the progress), ``label`` names the
@@ -319,11 +320,13 @@ class _Stepper:
     def begin(self, first: NNMResult, value: float) -> str | None:
         return None
 
+    @abstractmethod
     def advance(self, points: list[NNMResult], values: list[float]) -> _Attempt:
-        raise NotImplementedError
+        """One attempted step from the accepted points."""
 
+    @abstractmethod
     def reject(self, attempt: _Attempt, values: list[float]) -> str | None:
-        raise NotImplementedError
+        """Adapt to a failed attempt; a reason ends the branch."""
 
     def accept(self, attempt: _Attempt) -> None:
         pass

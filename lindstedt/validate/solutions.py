@@ -128,7 +128,7 @@ def _numeric_problem(source: Oscillator | Expansion, values: Mapping[Any, Any] |
     substitution = problem.numeric_substitution(values)
     omega0 = float(problem.omega0.xreplace(substitution))
     a0 = float(problem.a0.xreplace(substitution))
-    nonlinearity = sympy.sympify(problem.nonlinearity, strict=True).xreplace(substitution)
+    nonlinearity = problem.nonlinearity.xreplace(substitution)
     if problem.normalization == "harmonic":
         if not isinstance(source, Expansion):
             raise ProblemError(
