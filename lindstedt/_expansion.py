@@ -43,10 +43,11 @@ import sympy
 
 from ._assumptions import DerivationAssumptions, shown_values
 from ._errors import OrderError, ParameterError
-from .algebra.branch import Branch, EvaluationPoint, evaluate_float_terms
-from ._hierarchy import MAX_ORDER, SmoothHierarchy
-from ._piecewise_hierarchy import PiecewiseHierarchy
+from .algebra.branch import Branch, EvaluationPoint
 from ._problem import Oscillator
+from .engine.branches import BranchHierarchy, FloatBranches
+from .engine.contact import PiecewiseNormalForm
+from .engine.smooth import MAX_ORDER, NormalForm, SmoothHierarchy
 
 __all__ = ["Expansion", "ExpansionValidityWarning", "Waveform", "PiecewiseWaveform", "STRAINED_TIME", "EPSILON", "TIME"]
 
@@ -129,12 +130,6 @@ class Waveform:
     def to_latex(self) -> str:
         """LaTeX of the waveform through sympy's printer."""
         return _latex(self.to_expr())
-
-
-def _fold(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Reduce s to [0, π] using evenness and 2π-periodicity; also the sign of d/ds."""
-    shifted = np.mod(s + np.pi, 2 * np.pi) - np.pi
-    return np.abs(shifted), np.where(shifted < 0, -1.0, 1.0)
 
 
 @dataclass(frozen=True)
@@ -222,43 +217,39 @@ class Expansion:
 
     problem: Oscillator
     order: int
-    _hierarchy: SmoothHierarchy | PiecewiseHierarchy = field(repr=False, compare=False)
+    _hierarchy: SmoothHierarchy | BranchHierarchy = field(repr=False, compare=False)
+    _form: NormalForm | PiecewiseNormalForm = field(repr=False, compare=False)
 
     @property
     def is_piecewise(self) -> bool:
         """True for piecewise-linear f (unilateral springs)."""
-        return isinstance(self._hierarchy, PiecewiseHierarchy)
+        return self._form.regime != "smooth"
 
     @property
     def regime(self) -> str:
         """``"smooth"``, or for piecewise f: ``"contact"``, ``"no contact"`` or ``"grazing"``."""
-        return self._hierarchy.form.regime
+        return self._form.regime
 
     @property
     def validity_exponent(self) -> sympy.Rational:
         """p in the validity time T_ε ~ ε^p: −1 (simple roots of v0 − b), −1/2 (grazing, double root)."""
-        return self._hierarchy.form.validity_exponent
+        return self._form.validity_exponent
 
     @property
     def contact_angles(self) -> tuple[sympy.Expr, ...]:
         """β_i = arccos κ_i of the contact boundaries crossed by v_0 (empty for smooth f)."""
-        return tuple(boundary.contact_angle for boundary in self._hierarchy.form.boundaries)
+        return tuple(boundary.contact_angle for boundary in self._form.boundaries)
 
     def contact_angle_correction(self, order: int) -> tuple[sympy.Expr, ...]:
         """σ_{i,order}: the ε^order coefficient of the moving contact angles s_i*(ε) (empty for smooth f)."""
+        if not self._form.boundaries:
+            return ()
         return tuple(self._to_expr(value, order, sympy.Integer(1)) for value in self._hierarchy.boundary_shift(order))
 
     # -- exact quantities ---------------------------------------------------------------
-    @property
-    def _scale(self) -> sympy.Expr:
-        return self._hierarchy.form.epsilon_scale
-
     def _to_expr(self, element: Any, power: int, prefactor: sympy.Expr) -> sympy.Expr:
-        value = self._hierarchy.form.to_expr(element)
-        expression = prefactor * self._scale**power * value
-        if self._hierarchy.form.generator_values and not self.is_piecewise:
-            expression = sympy.expand(expression)
-        return expression
+        """prefactor · (ε̂/ε)^power · element: a coefficient of the normalised hierarchy in the problem's units."""
+        return self._form.scaled_expr(element, power, prefactor)
 
     def _check(self, order: int) -> None:
         if isinstance(order, bool) or not isinstance(order, int) or order < 0 or order > MAX_ORDER + 1:
@@ -278,11 +269,11 @@ class Expansion:
         """Exact v_order(s): a :class:`Waveform` (smooth f) or :class:`PiecewiseWaveform`."""
         self._check(order)
         if self.is_piecewise:
-            form = self._hierarchy.form
-            pieces = tuple(self._hierarchy.branches(order))
-            scale = self.problem.a0 * self._scale**order
+            form = self._form
+            pieces = tuple(components[0] for components in self._hierarchy.branches(order))
+            scale = self.problem.a0 * form.epsilon_scale**order
             branches = tuple(scale * piece.to_expr(STRAINED_TIME, form.to_expr) for piece in pieces)
-            limits = (form.zero_point, *[b.point for b in form.boundaries], form.pi_point)
+            limits = (form.system.zero_point, *[b.point for b in form.boundaries], form.system.pi_point)
             return PiecewiseWaveform(
                 order=order,
                 breakpoints=self.contact_angles,
@@ -330,7 +321,7 @@ class Expansion:
 
     @cached_property
     def _assumptions(self) -> DerivationAssumptions:
-        return DerivationAssumptions(self.problem, self._hierarchy.form, self.order)
+        return DerivationAssumptions(self.problem, self._form, self.order)
 
     def _floats(self, expressions: list[sympy.Expr], values: Mapping[Any, Any] | None) -> np.ndarray:
         substitution = self._substitution(values)
@@ -403,84 +394,31 @@ class Expansion:
         """Float ω_0..ω_highest for these values (cached: repeated evaluations cost microseconds)."""
         return self._cached(("omega", highest), values, lambda: self._floats([self.omega_correction(k) for k in range(highest + 1)], values))
 
-    def _waveform_floats(self, values: Mapping[Any, Any] | None) -> tuple[list[tuple[int, int]], np.ndarray]:
-        """(order, harmonic) keys and float coefficients of v_0..v_N (smooth f)."""
+    def _float_branches(self, values: Mapping[Any, Any] | None) -> tuple[float, float, FloatBranches]:
+        """ε̂/ε, a0 and the float branches of v_0..v_N for these values (cached per values)."""
 
-        def compute() -> tuple[list[tuple[int, int]], np.ndarray]:
-            keys = [(waveform.order, harmonic) for waveform in self.waveforms for harmonic, _ in waveform.coefficients]
-            expressions = [value for waveform in self.waveforms for _, value in waveform.coefficients]
-            return keys, self._floats(expressions, values)
-
-        return self._cached("waveforms", values, compute)
-
-    def _combined_coefficients(self, epsilon: float, values: Mapping[Any, Any] | None) -> tuple[np.ndarray, np.ndarray, float]:
-        combined: dict[int, float] = {}
-        keys, numbers = self._waveform_floats(values)
-        for (order, harmonic), number in zip(keys, numbers):
-            combined[harmonic] = combined.get(harmonic, 0.0) + number * epsilon**order
-        frequency = float(np.polynomial.polynomial.polyval(epsilon, self._frequency_coefficients(self.order + 1, values)))
-        harmonics = np.array(sorted(combined), dtype=float)
-        return harmonics, np.array([combined[int(h)] for h in harmonics]), frequency
-
-    def _piecewise_floats(self, values: Mapping[Any, Any] | None) -> tuple[float, float, list, list]:
-        """ε̂/ε, a0, per-order per-piece float branch terms and per-order boundary shifts (piecewise f)."""
-
-        def compute() -> tuple[float, float, list, list]:
+        def compute() -> tuple[float, float, FloatBranches]:
             substitution = self._substitution(values)
-            form = self._hierarchy.form
+            form = self._form
 
             def to_float(element: Any) -> float:
                 return _to_float(form.to_expr(element).xreplace(substitution))
 
-            branch_terms = [
-                [{key: to_float(element) for key, element in branch.terms.items()} for branch in self._hierarchy.branches(order)]
-                for order in range(self.order + 1)
-            ]
-            shifts = [[to_float(value) for value in self._hierarchy.boundary_shift(order)] for order in range(self.order + 1)]
-            numbers = [value for order_terms in branch_terms for terms in order_terms for value in terms.values()]
-            _finite(np.array(numbers + [value for order_shifts in shifts for value in order_shifts], dtype=float), substitution)
-            return float(self._scale.xreplace(substitution)), float(self.problem.a0.xreplace(substitution)), branch_terms, shifts
+            branches = self._hierarchy.float_branches(self.order, to_float)
+            numbers = [term[3] for order in branches.terms for piece in order for component in piece for term in component]
+            _finite(np.array(numbers + [value for order in branches.shifts for value in order], dtype=float), substitution)
+            scale = float(form.epsilon_scale.xreplace(substitution))
+            return scale, float(self.problem.a0.xreplace(substitution)), branches
 
-        return self._cached("piecewise", values, compute)
+        return self._cached("branches", values, compute)
 
-    def _piecewise_float_data(self, epsilon: float, values: Mapping[Any, Any] | None):
-        scale, amplitude, branch_terms, shifts = self._piecewise_floats(values)
-        scale_value = scale * epsilon
-        pieces: list[dict[tuple[int, int, int], float]] = [dict() for _ in self._hierarchy.form.piece_coefficients]
-        for order, order_terms in enumerate(branch_terms):
-            weight = amplitude * scale_value**order
-            for piece, terms in enumerate(order_terms):
-                for key, value in terms.items():
-                    pieces[piece][key] = pieces[piece].get(key, 0.0) + weight * value
-        boundaries = [
-            sum(shifts[order][index] * scale_value**order for order in range(self.order + 1))
-            for index in range(len(self._hierarchy.form.boundaries))
-        ]
-        frequency = float(np.polynomial.polynomial.polyval(epsilon, self._frequency_coefficients(self.order + 1, values)))
-        terms = [[(j, parity, power, value) for (j, parity, power), value in piece.items()] for piece in pieces]
-        return np.array(boundaries), terms, frequency
-
-    def _piecewise_evaluate(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None, derivative: bool) -> np.ndarray:
-        boundaries, terms, frequency = self._piecewise_float_data(float(epsilon), values)
-        times = np.asarray(t, dtype=float)
-        folded, sign = _fold(times * frequency)
-        piece_index = np.searchsorted(boundaries, folded)
-        result = np.zeros_like(folded)
-        for piece, piece_terms in enumerate(terms):
-            mask = piece_index == piece
-            if not np.any(mask):
-                continue
-            if derivative:
-                derived = []
-                for harmonic, parity, power, value in piece_terms:
-                    # d/ds s^m trig(js) = m s^{m-1} trig(js) ± j s^m trig'(js)
-                    if power:
-                        derived.append((harmonic, parity, power - 1, value * power))
-                    if harmonic:
-                        derived.append((harmonic, 1 - parity, power, value * harmonic * (-1 if parity == 0 else 1)))
-                result[mask] = evaluate_float_terms(derived, folded[mask]) * sign[mask] * frequency
-            else:
-                result[mask] = evaluate_float_terms(piece_terms, folded[mask])
+    def _evaluate(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None, derivative: bool) -> Any:
+        scale, amplitude, branches = self._float_branches(values)
+        frequency = float(np.polynomial.polynomial.polyval(float(epsilon), self._frequency_coefficients(self.order + 1, values)))
+        strained = np.asarray(t, dtype=float) * frequency
+        result = amplitude * branches.evaluate(strained, scale * float(epsilon), derivative)[..., 0]
+        if derivative:
+            result = result * frequency
         return result if result.ndim else float(result)
 
     def displacement(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None = None) -> np.ndarray:
@@ -496,19 +434,11 @@ class Expansion:
         >>> float(e.displacement(0.0, 0.1))
         1.0
         """
-        if self.is_piecewise:
-            return self._piecewise_evaluate(t, epsilon, values, derivative=False)
-        harmonics, coefficients, frequency = self._combined_coefficients(float(epsilon), values)
-        phase = np.multiply.outer(np.asarray(t, dtype=float) * frequency, harmonics)
-        return np.cos(phase) @ coefficients
+        return self._evaluate(t, epsilon, values, derivative=False)
 
     def velocity(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None = None) -> np.ndarray:
         """u'(t) of the same approximation as :meth:`displacement`."""
-        if self.is_piecewise:
-            return self._piecewise_evaluate(t, epsilon, values, derivative=True)
-        harmonics, coefficients, frequency = self._combined_coefficients(float(epsilon), values)
-        phase = np.multiply.outer(np.asarray(t, dtype=float) * frequency, harmonics)
-        return -np.sin(phase) @ (coefficients * harmonics) * frequency
+        return self._evaluate(t, epsilon, values, derivative=True)
 
     # -- symbolic views and exports -------------------------------------------------------
     def frequency_expr(self, order: int | None = None) -> sympy.Expr:

@@ -1,9 +1,9 @@
 """The method of strained coordinates (Lindstedt–Poincaré) for u'' + ω0² u + ε f(u) = 0: the verb ``expand``.
 
 :class:`LindstedtPoincare` chooses the engine for the problem — the smooth
-hierarchy (:mod:`lindstedt._hierarchy`, cosine series) or the piecewise one
-(:mod:`lindstedt._piecewise_hierarchy`, analytic branches between moving contact
-angles) — and wraps it in an :class:`~lindstedt.Expansion`.  Hierarchies are lazy
+hierarchy (:mod:`lindstedt.engine.smooth`, cosine series) or the branch one
+(:mod:`lindstedt.engine.branches`, analytic branches between moving contact
+angles, fed by :mod:`lindstedt.engine.contact`) — and wraps it in an :class:`~lindstedt.Expansion`.  Hierarchies are lazy
 and kept in one bounded process-wide cache (:func:`clear_cache`, :func:`cache_info`).
 """
 
@@ -15,9 +15,10 @@ from typing import Any, Callable, Hashable, Mapping, NamedTuple
 
 from ._errors import OrderError, ProblemError
 from ._expansion import Expansion
-from ._hierarchy import MAX_ORDER, SmoothHierarchy, normal_form
-from ._piecewise_hierarchy import PiecewiseHierarchy, piecewise_normal_form
 from ._problem import Oscillator
+from .engine.branches import BranchHierarchy
+from .engine.contact import contact_normal_form
+from .engine.smooth import MAX_ORDER, SmoothHierarchy, normal_form
 
 __all__ = ["CACHE_MAXSIZE", "CacheInfo", "LindstedtPoincare", "cache_info", "clear_cache", "expand", "validate_order"]
 
@@ -155,8 +156,8 @@ class LindstedtPoincare:
         self.precision = precision
         self.numeric = bool(numeric)
 
-    def hierarchy(self, problem: Oscillator, order: int = 4):
-        """The (cached) normalised hierarchy of ``problem`` (smooth or piecewise-linear).
+    def hierarchy(self, problem: Oscillator, order: int = 4) -> tuple[Any, Any]:
+        """The normal form of ``problem`` and its (cached) hierarchy: smooth, or the branch hierarchy.
 
         ``order`` is the highest order that will be asked for; float hierarchies
         of piecewise problems near grazing add guard digits for it.
@@ -170,19 +171,17 @@ class LindstedtPoincare:
             if not self.numeric:  # the problem's numbers are exact (the parser reads floats exactly)
                 # Exact: the normal form does not depend on the order; it is built only on a miss
                 # (its domain has fresh Dummy generators and must not enter the key).
-                return _CACHE.get(
-                    (problem_key, "piecewise", None),
-                    lambda: PiecewiseHierarchy(piecewise_normal_form(problem, None), problem.normalization),
-                )
-            # Float: the working digits (precision + guard digits near grazing, which grow with
-            # the order) decide the hierarchy; the float normal form is cheap, build it to know them.
-            form = piecewise_normal_form(problem, self.precision, order_hint=order + 1)
-            digits = form.domain.dps if form.prune_tolerance is not None else None
-            return _CACHE.get((problem_key, "piecewise", digits), lambda: PiecewiseHierarchy(form, problem.normalization))
+                key, build_form = (problem_key, "piecewise", None), lambda: contact_normal_form(problem, None)
+            else:
+                # Float: the working digits (precision + guard digits near grazing, which grow with
+                # the order) decide the hierarchy; the float normal form is cheap, build it to know them.
+                form = contact_normal_form(problem, self.precision, order_hint=order + 1)
+                key, build_form = (problem_key, "piecewise", form.domain.dps), lambda: form
+            return _CACHE.get(key, lambda: _with_form(build_form(), lambda form: BranchHierarchy(form.system, problem.normalization)))
         digits = None if problem.is_polynomial else self.precision
         return _CACHE.get(
             (problem_key, "smooth", digits),
-            lambda: SmoothHierarchy(normal_form(problem, self.precision), problem.normalization),
+            lambda: _with_form(normal_form(problem, self.precision), lambda form: SmoothHierarchy(form, problem.normalization)),
         )
 
     def expand(self, problem: Oscillator, order: int):
@@ -194,7 +193,12 @@ class LindstedtPoincare:
             Lazy, frozen result; nothing beyond the requested quantities is computed.
         """
         validate_order(order)
-        return Expansion(problem=problem, order=order, _hierarchy=self.hierarchy(problem, order))
+        form, hierarchy = self.hierarchy(problem, order)
+        return Expansion(problem=problem, order=order, _hierarchy=hierarchy, _form=form)
+
+
+def _with_form(form: Any, build: Callable[[Any], Any]) -> tuple[Any, Any]:
+    return form, build(form)
 
 
 def validate_order(order: Any) -> int:

@@ -27,7 +27,7 @@ from typing import Any, Iterable, Mapping
 import sympy
 from sympy import QQ
 
-__all__ = ["Branch", "EvaluationPoint", "evaluate_float_terms"]
+__all__ = ["Branch", "EvaluationPoint"]
 
 # A term key is (harmonic j >= 0, parity 0 = cos / 1 = sin, power m >= 0); (0, 1, m) never occurs.
 TermKey = tuple[int, int, int]
@@ -124,26 +124,6 @@ def _antiderivative(key: TermKey) -> _RationalTerms:
         for sub_key, value in _antiderivative((harmonic, 1 - parity, power - 1)):
             _add_into(result, sub_key, QQ(-sign * power, harmonic) * value)
     return tuple((k, v) for k, v in result.items() if v)
-
-
-def evaluate_float_terms(terms: Iterable[tuple[Any, int, int, float]], s: Any) -> Any:
-    """Σ value · s^power · (cos|sin)(frequency · s) over float ``(frequency, parity, power, value)`` terms (numpy).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> float(evaluate_float_terms([(1, 0, 1, 2.0)], np.array(0.5)))   # 2 s cos s at s = 0.5
-    0.8775825618903728
-    """
-    import numpy as np
-
-    points = np.asarray(s, dtype=float)
-    total = np.zeros_like(points)
-    for frequency, parity, power, value in terms:
-        argument = float(frequency) * points
-        trig = np.cos(argument) if parity == 0 else np.sin(argument)
-        total = total + value * points**power * trig
-    return total
 
 
 class EvaluationPoint:

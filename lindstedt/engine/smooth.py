@@ -45,10 +45,11 @@ import mpmath
 import sympy
 from sympy import QQ, RealField
 
-from .algebra.cosine import CosineSeries, solve_harmonic_oscillator, sum_series
-from ._errors import UnsupportedNonlinearityError
-from ._problem import DISPLACEMENT, Oscillator
-from ._series_algebra import extend_square_root
+from ..algebra.cosine import CosineSeries, solve_harmonic_oscillator, sum_series
+from .._errors import UnsupportedNonlinearityError
+from .._problem import DISPLACEMENT, Oscillator
+from .branches import FloatBranches
+from .orders import LazyOrders
 
 __all__ = ["MAX_ORDER", "NormalForm", "SmoothHierarchy", "normal_form"]
 
@@ -93,6 +94,11 @@ class NormalForm:
         if self.generator_values:
             expression = expression.subs(dict(self.generator_values))
         return expression
+
+    def scaled_expr(self, element: Any, power: int, prefactor: sympy.Expr) -> sympy.Expr:
+        """``prefactor · q_L^power · element`` in the problem's symbols (expanded when ratios are generators)."""
+        expression = prefactor * self.epsilon_scale**power * self.to_expr(element)
+        return sympy.expand(expression) if self.generator_values else expression
 
 
 def _cosine_powers(domain: Any, highest: int) -> list[CosineSeries]:
@@ -250,7 +256,7 @@ def normal_form(problem: Oscillator, digits: int = 30) -> NormalForm:
     return _analytic_normal_form(problem, digits)
 
 
-class SmoothHierarchy:
+class SmoothHierarchy(LazyOrders):
     """Lazy, cached hierarchy ``A_k``, ``w_k`` of the normal form.
 
     Examples
@@ -273,11 +279,6 @@ class SmoothHierarchy:
         self._forcing: dict[int, CosineSeries] = {}
         self._forcing_secular: dict[int, Any] = {}
         self.counters = {"products": 0, "secular_projections": 0}
-
-    # -- pieces ---------------------------------------------------------------------------
-    def boundary_shift(self, order: int) -> tuple:
-        """No contact boundaries move: smooth f has none."""
-        return ()
 
     def _prune(self, series: CosineSeries) -> CosineSeries:
         if self.form.prune_tolerance is None:
@@ -339,19 +340,20 @@ class SmoothHierarchy:
             self._forcing_secular[order] = total
         return self._forcing_secular[order]
 
-    def squared_frequency(self, order: int) -> Any:
-        """``A_order``: coefficient of ε̂^order in Ω²."""
-        while len(self._squared) <= order:
-            k = len(self._squared)
-            value = self.forcing_secular(k - 1)
-            for i in range(1, k):
-                value = value - self._squared[i] * self.waveform(k - i).coefficient(1)
-            self._squared.append(value)
-        return self._squared[order]
+    def _solve_order(self, k: int) -> None:
+        """A_k = [F_{k−1}]_1 − Σ_{i<k} A_i [w_{k−i}]_1 (the waveforms follow lazily in :meth:`waveform`)."""
+        value = self.forcing_secular(k - 1)
+        for i in range(1, k):
+            value = value - self._squared[i] * self.waveform(k - i).coefficient(1)
+        self._squared.append(value)
 
-    def frequency(self, order: int) -> Any:
-        """``Ω_order``: coefficient of ε̂^order in Ω = sqrt(Σ A_k ε̂^k)."""
-        return extend_square_root(self._frequencies, self.squared_frequency, order, self._domain)
+    def float_branches(self, highest: int, to_float: Callable[[Any], float] = float) -> FloatBranches:
+        """w_0 … w_highest as one float branch each (one piece, no contact boundary)."""
+        terms = tuple(
+            (([(harmonic, 0, 0, to_float(value)) for harmonic, value in self.waveform(k).coefficients.items()],),)
+            for k in range(highest + 1)
+        )
+        return FloatBranches(terms, ((),) * (highest + 1))
 
     def waveform(self, order: int) -> CosineSeries:
         """``w_order`` (normalised correction of order ``order``)."""

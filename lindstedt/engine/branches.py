@@ -1,0 +1,470 @@
+"""The branch hierarchy: strained coordinates for piecewise-linear systems with moving contact boundaries.
+
+One engine for every piecewise-linear case — the 1-dof unilateral spring is its
+N = 1 instance, the NNM of an N-dof system with unilateral springs the general
+one.  In normalised variables (strained time ``s = ω t``, ``Ω = ω/λ``,
+``ε̂ = ε/λ²``, ``W = U/a0``) the problem is
+
+    Ω² W'' + R² W + ε̂ (L_p W + m_p) = 0,   W_0 = e_j cos s,   R = diag(r_k), r_j = 1,
+
+where the contact state p — and with it the stiffness ``L_p`` and the load
+``m_p`` — changes where a contact function ``Σ_k c_ik W_k(s) − κ_i`` changes
+sign.  At ε = 0 that happens at the contact angle ``β_i = arccos κ_i`` (a
+simple root); for ε > 0 at ``s_i*(ε) = β_i + Σ_n σ_{i,n} ε̂^n``.
+
+On the piece p of [0, π] between consecutive crossings the equations are linear
+with constant coefficients, so every correction is an analytic quasi-
+trigonometric branch (:mod:`lindstedt.algebra.branch`), continued past the
+piece's ends.  With ``Ω² = Σ A_n ε̂^n`` order n reads, component by component,
+
+    W_{n,k}'' + r_k² W_{n,k} = A_n δ_kj cos s − Σ_{i<n} A_i W_{n−i,k}'' − (L_p W_{n−1})_k − δ_{n1} (m_p)_k.
+
+Unknowns of order n: ``A_n``, the homogeneous parts ``c cos(r_k s) + d sin(r_k s)``
+of every component on every piece, and the boundary shifts ``σ_{i,n}``.
+Conditions: ``W_k'(0) = 0`` and ``W_k'(π) = 0`` (even, 2π-periodic); C¹
+matching of every component at every moving boundary and the contact condition
+``Σ_k c_ik W_k(s_i*) = κ_i`` — Taylor-expanded about β_i, so values and
+integrals with moving limits are closed forms; and one normalisation of the
+mode component: ``W_{n,j}(0) = δ_{n1} w_1`` ("initial", the release) or zero
+first harmonic of the exact ``W_j`` including the moving-boundary terms
+("harmonic").  ``W_j'(π) = 0`` is the secular (Fredholm) condition that fixes
+``A_n``; for k ≠ j it fixes the periodic solution, which exists iff r_k ∉ ℤ.
+
+Coefficients live in any sympy field: exact (``QQ``, ``QQ(π, κ, β, …)``) or a
+``RealField`` of the working precision.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any, Sequence
+
+import mpmath
+import numpy as np
+
+from .._errors import ResonanceError
+from ..algebra.branch import Branch, EvaluationPoint
+from .orders import LazyOrders, shift_powers
+
+__all__ = ["BranchHierarchy", "BranchSystem", "ContactState", "FloatBranches", "MovingBoundary"]
+
+
+@dataclass(frozen=True)
+class ContactState:
+    """One contact state: the linear law ε̂ (L W + m) on a piece of [0, π] (rows of domain elements)."""
+
+    stiffness: tuple[tuple[Any, ...], ...]
+    load: tuple[Any, ...]
+
+
+@dataclass(frozen=True)
+class MovingBoundary:
+    """A contact angle β = arccos κ where ``Σ_k coupling[k] W_k`` crosses κ (``sine`` = sin β ≠ 0)."""
+
+    point: EvaluationPoint
+    coupling: tuple[Any, ...]
+    sine: Any
+
+
+@dataclass(frozen=True)
+class BranchSystem:
+    """The normalised piecewise-linear problem that :class:`BranchHierarchy` solves (module docstring).
+
+    ``ratios[k] = r_k`` (``None`` for the mode component j, whose frequency is 1
+    and whose solves use the exact rational kernel); ``states`` has one entry per
+    piece of [0, π], ``boundaries`` one per crossing, increasing in angle;
+    ``release`` is ``w_1``, the order-1 value of W_j(0) under the "initial" normalisation.
+    """
+
+    domain: Any
+    ratios: tuple[Any, ...]
+    mode: int
+    states: tuple[ContactState, ...]
+    boundaries: tuple[MovingBoundary, ...]
+    zero_point: EvaluationPoint
+    pi_point: EvaluationPoint
+    release: Any
+
+    @property
+    def size(self) -> int:
+        """Number of components N."""
+        return len(self.ratios)
+
+    def frequency(self, component: int) -> Any:
+        """r_k as a branch frequency (the integer 1 for the mode component)."""
+        ratio = self.ratios[component]
+        return 1 if ratio is None else ratio
+
+
+class _Affine:
+    """A value of order n, affine in the unknowns (A_n, c_1 … c_N): base + Σ coefficient·unknown."""
+
+    __slots__ = ("base", "coefficients")
+
+    def __init__(self, base: Any, coefficients: list[Any]):
+        self.base = base
+        self.coefficients = coefficients
+
+    def __add__(self, other: "_Affine") -> "_Affine":
+        return _Affine(self.base + other.base, [a + b for a, b in zip(self.coefficients, other.coefficients)])
+
+    def __sub__(self, other: "_Affine") -> "_Affine":
+        return _Affine(self.base - other.base, [a - b for a, b in zip(self.coefficients, other.coefficients)])
+
+    def scale(self, factor: Any) -> "_Affine":
+        return _Affine(self.base * factor, [a * factor for a in self.coefficients])
+
+    def shift(self, constant: Any) -> "_Affine":
+        return _Affine(self.base + constant, list(self.coefficients))
+
+    def value(self, unknowns: Sequence[Any]) -> Any:
+        total = self.base
+        for coefficient, unknown in zip(self.coefficients, unknowns):
+            total = total + coefficient * unknown
+        return total
+
+
+def solve_linear(matrix: list[list[Any]], vector: list[Any], domain: Any, order: int) -> list[Any]:
+    """Gaussian elimination in ``domain``: partial pivoting for floats, first nonzero pivot when exact.
+
+    Measured against ``mpmath.lu_solve`` (which needs conversion to and from mpf
+    matrices) and ``DomainMatrix.lu_solve`` (no partial pivoting for floats) on the
+    package's (N + 1)-square systems, this loop is kept: it works in the domain itself.
+    """
+    size = len(vector)
+    rows = [row[:] + [value] for row, value in zip(matrix, vector)]
+    exact = domain.is_Exact
+    threshold = None
+    if not exact:
+        scale = max((abs(entry) for row in matrix for entry in row), default=domain.one) or domain.one
+        threshold = scale * mpmath.mpf(10) ** (-(domain.dps - 3))
+    for column in range(size):
+        if exact:
+            pivot = next((r for r in range(column, size) if rows[r][column]), None)
+        else:
+            pivot = max(range(column, size), key=lambda r: abs(rows[r][column]))
+            pivot = pivot if abs(rows[pivot][column]) > threshold else None
+        if pivot is None:
+            raise ResonanceError(f"the order-{order} matching system is singular (internal resonance or tangent contact)")
+        rows[column], rows[pivot] = rows[pivot], rows[column]
+        for r in range(column + 1, size):
+            factor = rows[r][column] / rows[column][column]
+            if factor:
+                rows[r] = [a - factor * b for a, b in zip(rows[r], rows[column])]
+    solution = [domain.zero] * size
+    for r in range(size - 1, -1, -1):
+        total = rows[r][size]
+        for c in range(r + 1, size):
+            total = total - rows[r][c] * solution[c]
+        solution[r] = total / rows[r][r]
+    return solution
+
+
+@dataclass(frozen=True)
+class FloatBranches:
+    """Float image of W_0 … W_N for fast evaluation between the moving contact angles.
+
+    ``terms[n][p][k]`` lists ``(frequency, parity, power, value)`` of W_{n,k} on piece p;
+    ``shifts[n][i]`` is σ_{i,n} (n = 0: the contact angle β_i).
+    """
+
+    terms: tuple
+    shifts: tuple
+
+    @cached_property
+    def _arrays(self) -> tuple[np.ndarray, list[list[list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]]]]:
+        """The shifts as an (orders × boundaries) array; per piece and component, per parity, the
+        frequencies, powers and an (orders × terms) coefficient matrix: a new ε costs small matrix products."""
+        shifts = np.array(self.shifts, dtype=float).reshape(len(self.shifts), -1)
+        pieces = []
+        for piece in range(len(self.terms[0])):
+            components = []
+            for component in range(len(self.terms[0][piece])):
+                groups = []
+                for parity in (0, 1):
+                    keys = sorted({(t[0], t[2]) for order in self.terms for t in order[piece][component] if t[1] == parity})
+                    if not keys:
+                        continue
+                    index = {key: position for position, key in enumerate(keys)}
+                    coefficients = np.zeros((len(self.terms), len(keys)))
+                    for n, order in enumerate(self.terms):
+                        for frequency, term_parity, power, value in order[piece][component]:
+                            if term_parity == parity:
+                                coefficients[n, index[frequency, power]] += value
+                    frequencies, powers = (np.array(column, dtype=float) for column in zip(*keys))
+                    groups.append((parity, frequencies, powers, coefficients))
+                components.append(groups)
+            pieces.append(components)
+        return shifts, pieces
+
+    def evaluate(self, strained_time: Any, scaled_epsilon: float, derivative: bool = False) -> np.ndarray:
+        """Σ_n ε̂^n W_n(s) (or d/ds of it) at the strained times s; shape ``s.shape + (N,)``."""
+        folded, sign = fold(np.asarray(strained_time, dtype=float))
+        shifts, pieces = self._arrays
+        weights = float(scaled_epsilon) ** np.arange(len(self.terms))
+        piece_index = np.searchsorted(weights @ shifts, folded)
+        result = np.zeros(folded.shape + (len(pieces[0]),))
+        for piece, components in enumerate(pieces):
+            mask = piece_index == piece
+            if not np.any(mask):
+                continue
+            points = folded[mask]
+            for component, groups in enumerate(components):
+                values = sum((_evaluate_terms(*group[:3], weights @ group[3], points, derivative) for group in groups), np.zeros(points.shape))
+                result[mask, component] = values * sign[mask] if derivative else values
+        return result
+
+
+def _evaluate_terms(parity: int, frequency: np.ndarray, power: np.ndarray, value: np.ndarray, s: np.ndarray, derivative: bool) -> np.ndarray:
+    """Σ value s^m trig(ν s) (trig = cos for parity 0, sin for 1), or its s-derivative, vectorised."""
+    argument = np.multiply.outer(s, frequency)
+    trig = np.cos(argument) if parity == 0 else np.sin(argument)
+    constant_power = not power.any()
+    powers = 1.0 if constant_power else np.power.outer(s, power)
+    if not derivative:
+        return (trig * powers) @ value
+    # d/ds s^m trig(νs) = m s^{m−1} trig(νs) + ν s^m trig'(νs),  cos' = −sin, sin' = cos
+    slope = (-np.sin(argument) if parity == 0 else np.cos(argument)) * frequency * powers
+    if not constant_power:
+        slope = slope + trig * np.where(power > 0, power * np.power.outer(s, np.maximum(power - 1, 0)), 0.0)
+    return slope @ value
+
+
+def fold(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Reduce s to [0, π] using evenness and 2π-periodicity; also the sign of d/ds."""
+    shifted = np.mod(s + np.pi, 2 * np.pi) - np.pi
+    return np.abs(shifted), np.where(shifted < 0, -1.0, 1.0)
+
+
+class BranchHierarchy(LazyOrders):
+    """Order-by-order solution of a :class:`BranchSystem` (see the module docstring).
+
+    Examples
+    --------
+    >>> from lindstedt.engine.contact import contact_normal_form
+    >>> from lindstedt._problem import Oscillator
+    >>> form = contact_normal_form(Oscillator("Max(0, u)", a0=1, omega0=1))
+    >>> hierarchy = BranchHierarchy(form.system, "initial")
+    >>> form.to_expr(hierarchy.squared_frequency(2))
+    -3/16
+    """
+
+    def __init__(self, system: BranchSystem, normalization: str = "initial"):
+        self.system = system
+        self.normalization = normalization
+        domain = system.domain
+        self._domain = domain
+        self._branches: list[list[list[Branch]]] = [
+            [[Branch.cosine(domain) if k == system.mode else Branch(domain) for k in range(system.size)] for _ in system.states]
+        ]
+        self._squared: list[Any] = [domain.one]
+        self._frequencies: list[Any] = [domain.one]
+        self._shifts: list[list[Any]] = [[boundary.point.value for boundary in system.boundaries]]
+        self._derivatives: dict[tuple[int, int, int, int], Branch] = {}
+        self._resonant = Branch(domain, {(1, 1, 1): domain.one / domain.convert(2)})  # s sin s / 2 solves v'' + v = cos s
+        self.counters = {"orders": 0}
+
+    # -- read access ---------------------------------------------------------------------------------
+    def branches(self, order: int) -> list[list[Branch]]:
+        """W_order: ``branches(order)[piece][component]``."""
+        self._ensure(order)
+        return self._branches[order]
+
+    def boundary_shift(self, order: int) -> list[Any]:
+        """σ_{i,order} for every boundary (order 0: the contact angles β_i)."""
+        self._ensure(order)
+        return self._shifts[order]
+
+    def release(self, order: int, component: int) -> Any:
+        """W_{order, component}(0)."""
+        return self.branches(order)[0][component].evaluate(self.system.zero_point)
+
+    def float_branches(self, highest: int, to_float: Any = float) -> FloatBranches:
+        """:class:`FloatBranches` of W_0 … W_highest, coefficients converted by ``to_float``."""
+        terms = tuple(
+            tuple(
+                tuple(
+                    [
+                        (frequency if isinstance(frequency, int) else float(frequency), parity, power, to_float(value))
+                        for (frequency, parity, power), value in branch.terms.items()
+                    ]
+                    for branch in piece
+                )
+                for piece in self.branches(n)
+            )
+            for n in range(highest + 1)
+        )
+        shifts = tuple(tuple(to_float(value) for value in self.boundary_shift(n)) for n in range(highest + 1))
+        return FloatBranches(terms, shifts)
+
+    # -- the expansion about a moving boundary -------------------------------------------------------
+    def _derivative(self, order: int, piece: int, component: int, times: int) -> Branch:
+        key = (order, piece, component, times)
+        if key not in self._derivatives:
+            if times == 0:
+                self._derivatives[key] = self._branches[order][piece][component]
+            else:
+                self._derivatives[key] = self._derivative(order, piece, component, times - 1).derivative()
+        return self._derivatives[key]
+
+    def _shift_powers(self, boundary: int, order: int) -> list[list[Any]]:
+        """[δσ^n]_j for n, j <= order, δσ = Σ_{1<=i<order} σ_i ε̂^i (σ_order excluded)."""
+        return shift_powers([terms[boundary] for terms in self._shifts[:order]], order, self._domain)
+
+    def _known(self, boundary: int, piece: int, component: int, order: int, derivative: int, powers: list[list[Any]]) -> Any:
+        """ε̂^order coefficient of ∂^derivative W_component^piece at s*(ε̂), without W_order and σ_order."""
+        point = self.system.boundaries[boundary].point
+        domain = self._domain
+        total = domain.zero
+        factorial = 1
+        for times in range(1, order + 1):
+            factorial *= times
+            inverse = domain.one / domain.convert(factorial)
+            for j in range(0, order - times + 1):
+                weight = powers[times][order - j]
+                if weight:
+                    total = total + self._derivative(j, piece, component, times + derivative).evaluate(point) * weight * inverse
+        return total
+
+    def _boundary_first_harmonic(self, boundary: int, order: int, powers: list[list[Any]]) -> Any:
+        """ε̂^order coefficient of ∫_β^{s*} (W_j^p − W_j^{p+1}) cos s ds (known part)."""
+        point = self.system.boundaries[boundary].point
+        mode = self.system.mode
+        domain = self._domain
+        total = domain.zero
+        for j in range(1, order):
+            derivative = (self._branches[j][boundary][mode] - self._branches[j][boundary + 1][mode]).times_cosine(1)
+            factorial = 1
+            for times in range(0, order - j):
+                factorial *= times + 1
+                weight = powers[times + 1][order - j]
+                if weight:
+                    total = total + derivative.evaluate(point) * weight / domain.convert(factorial)
+                derivative = derivative.derivative()
+        return total
+
+    # -- one order -------------------------------------------------------------------------------------
+    def _solve_order(self, order: int) -> None:
+        system, domain = self.system, self._domain
+        zero, one = domain.zero, domain.one
+        size, mode = system.size, system.mode
+        resonant = self._resonant
+        unknown_count = size + 1  # A_n, then c_k on the first piece for every component k
+
+        def constant(value: Any) -> _Affine:
+            return _Affine(value, [zero] * unknown_count)
+
+        def unit(index: int) -> _Affine:
+            return _Affine(zero, [one if position == index else zero for position in range(unknown_count)])
+
+        particular: list[list[Branch]] = []
+        for piece, state in enumerate(system.states):
+            components = []
+            for k in range(size):
+                rhs = Branch(domain)
+                for i in range(1, order):
+                    rhs = rhs - self._derivative(order - i, piece, k, 2).scale(self._squared[i])
+                for l, entry in enumerate(state.stiffness[k]):
+                    if entry:
+                        rhs = rhs - self._branches[order - 1][piece][l].scale(entry)
+                if order == 1 and state.load[k]:
+                    rhs = rhs - Branch.constant(domain, state.load[k])
+                components.append(rhs.oscillator_particular_solution(system.ratios[k]))
+            particular.append(components)
+
+        def value_of(piece: int, k: int, c: _Affine, d: _Affine, point: EvaluationPoint, slope: bool) -> _Affine:
+            """W_{n,k}^piece (or its slope) at point, for homogeneous parts c, d."""
+            frequency = system.frequency(k)
+            ratio = one if system.ratios[k] is None else system.ratios[k]
+            cosine, sine = point.cos_multiple(frequency), point.sin_multiple(frequency)
+            branch = particular[piece][k].derivative() if slope else particular[piece][k]
+            result = constant(branch.evaluate(point))
+            if k == mode:
+                result = result + unit(0).scale((resonant.derivative() if slope else resonant).evaluate(point))
+            if slope:
+                return result + c.scale(-sine * ratio) + d.scale(cosine * ratio)
+            return result + c.scale(cosine) + d.scale(sine)
+
+        # First piece: c_k free, d_k from W_k'(0) = 0 (d_k r_k + slope without d = 0).
+        c_values = [[unit(1 + k) for k in range(size)]]
+        d_values = []
+        first = []
+        for k in range(size):
+            slope_without_d = value_of(0, k, c_values[0][k], constant(zero), system.zero_point, True)
+            ratio = one if system.ratios[k] is None else system.ratios[k]
+            first.append(slope_without_d.scale(-one / ratio))
+        d_values.append(first)
+        shift_values: list[_Affine] = []
+        for index, boundary in enumerate(system.boundaries):
+            point = boundary.point
+            powers = self._shift_powers(index, order)
+            left, right = index, index + 1
+            # Contact: Σ_k c_k W_k(s*) = κ  ->  order n: Σ_k c_k [W_{n,k}(β) + known_k] + c_j W_0'(β) σ_n = 0, W_0' = −sin β.
+            gap = constant(zero)
+            for k, coupling in enumerate(boundary.coupling):
+                if coupling:
+                    value = value_of(left, k, c_values[left][k], d_values[left][k], point, False)
+                    gap = gap + value.shift(self._known(index, left, k, order, 0, powers)).scale(coupling)
+            shift_values.append(gap.scale(one / (boundary.coupling[mode] * boundary.sine)))
+            # C¹ matching of every component: the homogeneous parts of the right piece.
+            c_next, d_next = [], []
+            for k in range(size):
+                value = value_of(left, k, c_values[left][k], d_values[left][k], point, False)
+                slope = value_of(left, k, c_values[left][k], d_values[left][k], point, True)
+                x = value.shift(self._known(index, left, k, order, 0, powers) - self._known(index, right, k, order, 0, powers))
+                y = slope.shift(self._known(index, left, k, order, 1, powers) - self._known(index, right, k, order, 1, powers))
+                x = x - value_of(right, k, constant(zero), constant(zero), point, False)
+                y = y - value_of(right, k, constant(zero), constant(zero), point, True)
+                frequency = system.frequency(k)
+                ratio = one if system.ratios[k] is None else system.ratios[k]
+                cosine, sine = point.cos_multiple(frequency), point.sin_multiple(frequency)
+                c_next.append(x.scale(cosine) - y.scale(sine / ratio))
+                d_next.append(x.scale(sine) + y.scale(cosine / ratio))
+            c_values.append(c_next)
+            d_values.append(d_next)
+        last = len(system.states) - 1
+        equations = [value_of(last, k, c_values[last][k], d_values[last][k], system.pi_point, True) for k in range(size)]
+        if self.normalization == "initial":
+            release = value_of(0, mode, c_values[0][mode], d_values[0][mode], system.zero_point, False)
+            equations.append(release.shift(-system.release) if order == 1 else release)
+        else:
+            equations.append(self._first_harmonic_condition(order, particular, c_values, d_values, unit(0)))
+        unknowns = solve_linear([list(e.coefficients) for e in equations], [-e.base for e in equations], domain, order)
+        branches = []
+        for piece in range(len(system.states)):
+            components = []
+            for k in range(size):
+                frequency = system.frequency(k)
+                homogeneous = Branch(
+                    domain,
+                    {(frequency, 0, 0): c_values[piece][k].value(unknowns), (frequency, 1, 0): d_values[piece][k].value(unknowns)},
+                )
+                branch = particular[piece][k] + homogeneous
+                if k == mode:
+                    branch = branch + resonant.scale(unknowns[0])
+                components.append(branch)
+            branches.append(components)
+        self._branches.append(branches)
+        self._squared.append(unknowns[0])
+        self._shifts.append([value.value(unknowns) for value in shift_values])
+        self.counters["orders"] += 1
+
+    def _first_harmonic_condition(self, order: int, particular: list, c_values: list, d_values: list, resonant_unit: _Affine) -> _Affine:
+        """ε̂^order coefficient of ∫_0^π W_j cos s ds (must vanish), affine in the unknowns."""
+        system, domain = self.system, self._domain
+        mode = system.mode
+        limits = [system.zero_point] + [b.point for b in system.boundaries] + [system.pi_point]
+        cos_cos = Branch.cosine(domain).times_cosine(1)
+        sin_cos = Branch.sine(domain).times_cosine(1)
+        resonant_cos = self._resonant.times_cosine(1)
+        total = resonant_unit.scale(domain.zero)
+        for piece, components in enumerate(particular):
+            lower, upper = limits[piece], limits[piece + 1]
+            total = total.shift(components[mode].times_cosine(1).integral(lower, upper))
+            total = total + resonant_unit.scale(resonant_cos.integral(lower, upper))
+            total = total + c_values[piece][mode].scale(cos_cos.integral(lower, upper))
+            total = total + d_values[piece][mode].scale(sin_cos.integral(lower, upper))
+        for index in range(len(system.boundaries)):
+            total = total.shift(self._boundary_first_harmonic(index, order, self._shift_powers(index, order)))
+        return total

@@ -1,0 +1,294 @@
+"""The 1-dof contact normal form: u'' + ω0² u + ε f(u) = 0 with f continuous and piecewise linear.
+
+Problem: ``u(0) = a0``, ``u'(0) = 0`` (or a0 the first-harmonic amplitude),
+f a sum of unilateral springs ``a (u − b)_+`` and linear terms.  With
+``w = u/a0``, ``ω = ω0 Ω``, ``ε̂ = ε/ω0²``:
+
+    Ω² w'' + w + ε̂ (ℓ_p w + m_p) = 0,   f̂(w) = λ w + μ/a0 on each w-interval,
+
+whose breakpoints ``κ_i = u_i/a0`` are crossed by ``w_0 = cos s`` at the
+contact angles ``β_i = arccos κ_i`` when |κ_i| < 1.  This module classifies
+the breakpoints against the orbit [−1, 1] (crossing, grazing, never reached,
+permanent contact), chooses the coefficient field (exact ``QQ(π, κ, β, sin β)``
+or a ``RealField`` with guard digits near grazing) and hands the
+:class:`~lindstedt.engine.branches.BranchSystem` with N = 1 component to the
+one branch hierarchy (:mod:`lindstedt.engine.branches`), which solves it order
+by order.
+
+The frequency is analytic in ε when no crossing is tangent (|κ_i| ≠ 1): the
+validity time is ~ε^{-1}.  A grazing breakpoint (|κ_i| = 1, double root of
+w_0 − κ_i) carries no contact at order zero; it is reported with validity
+~ε^{-1/2} (seed Prop. 2.3).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import mpmath
+import sympy
+from sympy import QQ, RealField
+
+from .._errors import ProblemError
+from .._piecewise_linear import decompose_piecewise_linear
+from .._problem import DISPLACEMENT, Oscillator
+from ..algebra.branch import EvaluationPoint
+from .branches import BranchSystem, ContactState, MovingBoundary
+
+__all__ = ["ContactBoundary", "PiecewiseNormalForm", "contact_normal_form"]
+
+
+@dataclass(frozen=True)
+class ContactBoundary:
+    """A breakpoint crossed by w_0 = cos s at the contact angle β = arccos κ."""
+
+    kappa: sympy.Expr
+    contact_angle: sympy.Expr
+    point: EvaluationPoint
+    kappa_element: Any
+    sine_element: Any
+
+
+@dataclass(frozen=True)
+class PiecewiseNormalForm:
+    """Normalised piecewise-linear problem on [0, π] (see module docstring)."""
+
+    domain: Any
+    epsilon_scale: sympy.Expr
+    generator_values: tuple[tuple[sympy.Symbol, sympy.Expr], ...]
+    piece_coefficients: tuple[tuple[Any, Any], ...]  # (ℓ_p, m_p) per piece in s
+    boundaries: tuple[ContactBoundary, ...]
+    grazing: tuple[sympy.Expr, ...]  # breakpoints κ with |κ| = 1
+    regime: str  # "contact", "no contact", "grazing"
+    validity_exponent: sympy.Rational
+    system: BranchSystem  # what the branch hierarchy solves (N = 1)
+    prune_tolerance: float | None = None
+    # The assumptions of the derivation (read by Expansion to check numeric ``values``):
+    # the sign of a0 it was derived for, and every w-breakpoint κ (increasing) with where it
+    # lies relative to the orbit [-1, 1]: "crossing" (|κ| < 1, decided or assumed), "grazing"
+    # (|κ| = 1), "above" (κ > 1: never reached) or "below" (κ < -1: permanent contact).
+    amplitude_sign: int = 1
+    breakpoint_classes: tuple[tuple[sympy.Expr, str], ...] = ()
+
+    def to_expr(self, element: Any) -> sympy.Expr:
+        """Domain element -> sympy expression with generators substituted."""
+        expression = self.domain.to_sympy(element)
+        if self.generator_values:
+            expression = expression.xreplace(dict(self.generator_values))
+        return expression
+
+    def scaled_expr(self, element: Any, power: int, prefactor: sympy.Expr) -> sympy.Expr:
+        """``prefactor · (1/ω0²)^power · element`` in the problem's symbols."""
+        return prefactor * self.epsilon_scale**power * self.to_expr(element)
+
+
+class _ConstantField:
+    """Chooses the coefficient domain and converts the constants of the problem into it."""
+
+    def __init__(self, values: list[sympy.Expr], digits: int | None):
+        self.numeric = digits is not None or any(v.has(sympy.Float) for v in values)
+        self.generators: list[tuple[sympy.Symbol, sympy.Expr]] = []
+        self._replacement: dict[sympy.Expr, sympy.Symbol] = {}
+        if self.numeric:
+            self.digits = digits or 30
+            self.domain = RealField(dps=self.digits)
+            return
+        self.digits = None
+        pi_generator = sympy.Dummy("pi")
+        self._replacement[sympy.pi] = pi_generator
+        self.generators.append((pi_generator, sympy.pi))
+        symbols: set[sympy.Symbol] = set()
+        for value in values:
+            symbols |= value.free_symbols
+        for symbol in sorted(symbols, key=str):
+            self.generators.append((symbol, symbol))
+        for value in values:
+            self._register(value)
+        self.domain = QQ.frac_field(*[generator for generator, _ in self.generators])
+
+    def _register(self, value: sympy.Expr) -> None:
+        for atom in sympy.preorder_traversal(value):
+            if isinstance(atom, (sympy.acos, sympy.Pow, sympy.asin, sympy.atan)) and atom not in self._replacement:
+                if isinstance(atom, sympy.Pow) and atom.exp.is_Integer:
+                    continue
+                generator = sympy.Dummy("g")
+                self._replacement[atom] = generator
+                self.generators.append((generator, atom))
+
+    def convert(self, value: sympy.Expr) -> Any:
+        value = sympy.sympify(value, strict=True)
+        if self.numeric:
+            return self.domain.convert(sympy.N(value, self.digits + 10))
+        if value.is_Rational:
+            return self.domain.convert(value)
+        ratio = sympy.simplify(value / sympy.pi) if value.is_number and value.has(sympy.pi) else None
+        if ratio is not None and ratio.is_Rational:
+            return self.domain.convert(ratio) * self.domain.from_sympy(self._replacement[sympy.pi])
+        self._register(value)
+        replaced = value.xreplace(self._replacement)
+        return self.domain.from_sympy(replaced)
+
+
+def _sign_of_amplitude(amplitude: sympy.Expr) -> int:
+    if amplitude.is_positive:
+        return 1
+    if amplitude.is_negative:
+        return -1
+    raise ProblemError(
+        f"the sign of a0 = {amplitude} decides which side of the gap the release point is on; "
+        "declare it: a0=sympy.Symbol('a0', positive=True) (or negative=True), or pass a number"
+    )
+
+
+def _compare(value: sympy.Expr, bound: int) -> int | None:
+    """Sign of value - bound when decidable, else None."""
+    difference = sympy.simplify(value - bound)
+    if difference.is_zero:
+        return 0
+    if difference.is_positive:
+        return 1
+    if difference.is_negative:
+        return -1
+    return None
+
+
+def _contact_sine(kappa: sympy.Expr) -> sympy.Expr:
+    """sin β = sqrt(1 − κ²), without sympy's perfect-power search for rationals with huge denominators."""
+    if kappa.is_Rational and kappa.q > 10**12:
+        return sympy.Pow(1 - kappa**2, sympy.Rational(1, 2), evaluate=False)
+    return sympy.sqrt(1 - kappa**2)
+
+
+def _guard_digits(kappas: list[sympy.Expr], order: int) -> int:
+    """Extra working digits for a float hierarchy near grazing.
+
+    Near |κ| = 1 the contact angle margin m = min(β, π − β) is small and the
+    order-k corrections are O(m^{2k+1}) differences of O(1) terms, so about
+    (2k + 3)·log10(1/m) digits cancel; they are added to the working precision.
+    """
+    margin = mpmath.mpf(1)
+    with mpmath.workdps(50):
+        for kappa in kappas:
+            if not kappa.is_number:
+                continue
+            angle = mpmath.acos(mpmath.mpf(sympy.N(kappa, 60)))
+            margin = min(margin, angle, mpmath.pi - angle)
+        if margin <= 0:
+            return 0
+        return int(mpmath.ceil((2 * order + 5) * max(0, -mpmath.log10(margin))))
+
+
+def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hint: int = 4) -> PiecewiseNormalForm:
+    """Build the normalised piecewise problem.
+
+    ``digits`` selects a numeric ``RealField`` (also chosen automatically when
+    the inputs contain floats); otherwise the hierarchy is exact.  In the
+    numeric case guard digits are added near grazing (see :func:`_guard_digits`)
+    so that ``digits`` stay correct up to order ``order_hint``.
+    """
+    intervals = decompose_piecewise_linear(problem.nonlinearity, DISPLACEMENT)
+    amplitude = problem.a0
+    sign = _sign_of_amplitude(amplitude)
+    # w-breakpoints κ_i = u_i / a0, and the linear law f̂(w) = λ w + μ/a0 on each interval.
+    w_intervals: list[tuple[sympy.Expr | None, sympy.Expr | None, sympy.Expr, sympy.Expr]] = []
+    for interval in intervals:
+        lower = None if interval.lower is None else interval.lower / amplitude
+        upper = None if interval.upper is None else interval.upper / amplitude
+        if sign < 0:
+            lower, upper = upper, lower
+        w_intervals.append((lower, upper, interval.slope, interval.intercept / amplitude))
+    if sign < 0:
+        w_intervals.reverse()
+    # Breakpoints in w, increasing; classify each against the orbit [-1, 1].
+    kappas = [upper for (_, upper, _, _) in w_intervals[:-1]]
+    crossing: list[int] = []
+    grazing: list[sympy.Expr] = []
+    classes: list[tuple[sympy.Expr, str]] = []
+    for index, kappa in enumerate(kappas):
+        below, above = _compare(kappa, -1), _compare(kappa, 1)
+        if below is None or above is None:
+            if len(kappas) > 1:
+                raise ProblemError(
+                    f"cannot decide whether the breakpoint kappa = {kappa} lies inside (-1, 1); give numeric gaps"
+                )
+            crossing.append(index)  # a single symbolic gap: the contact case |kappa| < 1 is assumed
+            classes.append((kappa, "crossing"))
+            continue
+        if below == 0 or above == 0:
+            grazing.append(kappa)
+            classes.append((kappa, "grazing"))
+        elif below > 0 and above < 0:
+            crossing.append(index)
+            classes.append((kappa, "crossing"))
+        else:
+            classes.append((kappa, "above" if above > 0 else "below"))
+    # Pieces in s: w_0 = cos s decreases from 1 to -1, so the crossings are met from the largest κ down.
+    crossing_kappas = [kappas[i] for i in crossing]
+    interval_of = []  # interval index (in w order) for each piece in s
+    # the interval containing w slightly below 1:
+    top_interval = len(w_intervals) - 1
+    for index, kappa in enumerate(kappas):
+        if _compare(kappa, 1) in (0, 1):
+            top_interval = index
+            break
+    current = top_interval
+    interval_of.append(current)
+    for index in reversed(crossing):
+        current = index  # crossing κ_index moves from interval index+1 down to index
+        interval_of.append(current)
+    values: list[sympy.Expr] = []
+    for interval_index in interval_of:
+        _, _, slope, intercept = w_intervals[interval_index]
+        values += [slope, intercept]
+    for kappa in crossing_kappas:
+        values += [kappa, sympy.acos(kappa), _contact_sine(kappa)]
+    numeric = digits is not None or any(value.has(sympy.Float) for value in values)
+    if numeric:
+        digits = (digits or 30) + _guard_digits(crossing_kappas, order_hint)
+    field = _ConstantField(values, digits)
+    domain = field.domain
+    piece_coefficients = []
+    for interval_index in interval_of:
+        _, _, slope, intercept = w_intervals[interval_index]
+        piece_coefficients.append((field.convert(slope), field.convert(intercept)))
+    boundaries = []
+    for kappa in sorted(crossing_kappas, key=lambda k: -k if k.is_number else 0):
+        angle = sympy.acos(kappa)
+        kappa_element = field.convert(kappa)
+        sine_element = field.convert(_contact_sine(kappa))
+        point = EvaluationPoint(domain, field.convert(angle), kappa_element, sine_element)
+        boundaries.append(ContactBoundary(kappa, angle, point, kappa_element, sine_element))
+    zero = EvaluationPoint(domain, domain.zero, domain.one, domain.zero)
+    pi_point = EvaluationPoint(domain, field.convert(sympy.pi), -domain.one, domain.zero)
+    system = BranchSystem(
+        domain=domain,
+        ratios=(None,),
+        mode=0,
+        states=tuple(ContactState(((slope,),), (intercept,)) for slope, intercept in piece_coefficients),
+        boundaries=tuple(MovingBoundary(b.point, (domain.one,), b.sine_element) for b in boundaries),
+        zero_point=zero,
+        pi_point=pi_point,
+        release=domain.zero,
+    )
+    if grazing:
+        regime = "grazing"
+    elif all(not ell and not m for ell, m in piece_coefficients):
+        regime = "no contact"
+    else:
+        regime = "contact"
+    validity = sympy.Rational(-1, 2) if grazing else sympy.Integer(-1)
+    return PiecewiseNormalForm(
+        domain=domain,
+        epsilon_scale=1 / problem.omega0**2,
+        generator_values=tuple(field.generators),
+        piece_coefficients=tuple(piece_coefficients),
+        boundaries=tuple(boundaries),
+        grazing=tuple(grazing),
+        regime=regime,
+        validity_exponent=validity,
+        system=system,
+        prune_tolerance=None if not field.numeric else 0.0,
+        amplitude_sign=sign,
+        breakpoint_classes=tuple(classes),
+    )

@@ -1,0 +1,180 @@
+"""The modal normal form of an N-dof unilateral system:  M X'' + K X + ε W (A X − b)_+ = 0.
+
+Seed §4 (Theorem 4.1, Corollary 4.2), derived here from the equations.  With
+the modes ``K Φ = M Φ Λ²``, ``Φᵀ M Φ = I`` and ``X = Φ U``:
+
+    U'' + Λ² U + ε G (B U − b)_+ = 0,      G = Φᵀ W,   B = A Φ.
+
+The NNM grown from mode j uses one strained time ``s = ω t`` for every modal
+coordinate; with ``U = a0 W``, ``Ω = ω/λ_j``, ``ε̂ = ε/λ_j²`` and ``r_k = λ_k/λ_j``
+
+    Ω² W'' + R² W + ε̂ G (a0 B W − b)_+ / a0 = 0,    W_0 = e_j cos s.
+
+Spring i's gap at order zero, ``a0 B_ij cos s − b_i``, crosses zero at the
+contact angle ``β_i = arccos(b_i/(a0 B_ij))`` when |b_i| < |a0 B_ij| (simple
+root); |b_i| = |a0 B_ij| is grazing (double root, validity ~ε^{-1/2}).
+Between consecutive angles the active set is fixed and the law is linear,
+``ε̂ (L_p W + m_p)`` with ``L_p = Σ_{i active} G_i B_iᵀ`` and
+``m_p = −Σ_{i active} G_i b_i / a0``: a
+:class:`~lindstedt.engine.branches.BranchSystem` with N components, solved by
+the one branch hierarchy.  Its release ``W_{1,j}(0) = a1 λ_j² / a0`` comes from
+``u_j(0) = a0 + ε a1``.  The arithmetic is a ``RealField`` of the requested
+precision; the mode shapes are computed there with mpmath.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import mpmath
+import numpy as np
+import sympy
+from sympy import RealField
+
+from .._errors import ProblemError, ResonanceError
+from .._system import UnilateralSystem
+from ..algebra.branch import EvaluationPoint
+from .branches import BranchSystem, ContactState, MovingBoundary
+
+__all__ = ["ModalNormalForm", "SpringAtOrderZero", "modal_guard_digits", "modal_normal_form"]
+
+_RESONANCE_TOLERANCE = 1e-9
+_GRAZING_TOLERANCE = 1e-12
+
+
+@dataclass(frozen=True)
+class SpringAtOrderZero:
+    """How spring i meets the linear mode: its coupling a0 B_ij, κ_i = b_i/(a0 B_ij) and status."""
+
+    index: int
+    coupling: Any
+    kappa: Any | None
+    orientation: int  # +1: contact for cos s > κ (near s = 0); -1: contact for cos s < κ
+    status: str  # "crossing", "grazing", "never", "always"
+
+
+@dataclass(frozen=True)
+class ModalNormalForm:
+    """The NNM problem of mode j in normalised modal variables (see the module docstring)."""
+
+    system: BranchSystem
+    digits: int
+    frequencies: tuple[Any, ...]  # λ_1 … λ_N in the domain
+    amplitude: Any
+    springs: tuple[SpringAtOrderZero, ...]
+    small_divisors: tuple[tuple[int, int, Any], ...]  # (k, nearest harmonic n, |r_k² − n²|), 0-based k
+
+
+def modal_guard_digits(system: UnilateralSystem, mode: int, order: int) -> int:
+    """Extra digits near an internal resonance: each order divides by |r_k² − n²| once more (mode 0-based)."""
+    frequencies = system.modes().frequencies
+    smallest = 1.0
+    for k, value in enumerate(frequencies):
+        if k == mode:
+            continue
+        ratio = value / frequencies[mode]
+        nearest = round(ratio)
+        smallest = min(smallest, abs(ratio * ratio - nearest * nearest) or 1e-300)
+    return int(np.ceil(max(0.0, -np.log10(smallest)) * max(order, 1)))
+
+
+def _small_divisors(ratios: list[Any], mode: int) -> tuple[tuple[int, int, Any], ...]:
+    divisors = []
+    for k, ratio in enumerate(ratios):
+        if k == mode:
+            continue
+        nearest = int(mpmath.nint(ratio))
+        if abs(ratio - nearest) < _RESONANCE_TOLERANCE * max(1, abs(ratio)):
+            raise ResonanceError(
+                f"internal resonance: lambda_{k + 1}/lambda_{mode + 1} = {mpmath.nstr(ratio, 12)} is the harmonic "
+                f"{nearest} of mode {mode + 1}; the strained-coordinates NNM of mode {mode + 1} does not exist "
+                "(choose another mode or detune the system)"
+            )
+        # smallest |r_k² − n²| over the harmonics n that the forcing contains
+        divisor = min(abs(ratio * ratio - n * n) for n in (nearest - 1, nearest, nearest + 1) if n >= 0)
+        divisors.append((k, nearest, divisor))
+    return tuple(divisors)
+
+
+def _classify(index: int, coupling: Any, gap: Any, digits: int, mode: int) -> SpringAtOrderZero:
+    scale = max(abs(coupling), abs(gap), 1)
+    if abs(coupling) <= mpmath.mpf(10) ** (-digits + 5) * scale:
+        if gap == 0:
+            raise ProblemError(
+                f"spring {index + 1} is not moved by mode {mode + 1} and has zero gap: its contact is degenerate; "
+                "give it a nonzero gap or choose another mode"
+            )
+        return SpringAtOrderZero(index, coupling, None, 1, "always" if gap < 0 else "never")
+    kappa = gap / coupling
+    orientation = 1 if coupling > 0 else -1
+    # |κ| within 1e-12 of 1: the contact lasts ~1e-6 of a period, valid only for ε ≪ 1e-12 as a
+    # simple root; report it as grazing (double root, validity ε^{-1/2}).
+    if abs(abs(kappa) - 1) <= _GRAZING_TOLERANCE:
+        status = "grazing"
+    elif abs(kappa) < 1:
+        status = "crossing"
+    elif (kappa >= 1) == (orientation > 0):
+        status = "never"
+    else:
+        status = "always"
+    return SpringAtOrderZero(index, coupling, kappa, orientation, status)
+
+
+def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, release_correction: Any, digits: int) -> ModalNormalForm:
+    """The modal normal form of the NNM of ``mode`` (0-based) released at u_j(0) = a0 + ε a1, in ``digits`` digits."""
+    domain = RealField(dps=digits)
+    size, springs_count = system.n_dof, system.n_springs
+
+    def convert(value: Any) -> Any:
+        value = value if isinstance(value, sympy.Basic) else sympy.Float(value, digits + 10)
+        return domain.from_sympy(sympy.N(value, digits + 10))
+
+    frequencies, shapes = system.modes_high_precision(digits + 10)
+    frequencies = [convert(value) for value in frequencies]
+    shapes = [[convert(value) for value in column] for column in shapes]  # shapes[k][row]
+    a0 = convert(amplitude)
+    lam = frequencies[mode]
+    ratios = [value / lam for value in frequencies]
+    small_divisors = _small_divisors(ratios, mode)
+    A = [[convert(v) for v in row] for row in system.A_exact.tolist()]
+    W = [[convert(v) for v in row] for row in system.W_exact.tolist()]
+    gaps = [convert(v) for v in list(system.b_exact)]
+    B = [[sum((A[i][row] * shapes[k][row] for row in range(size)), domain.zero) for k in range(size)] for i in range(springs_count)]
+    G = [[sum((shapes[k][row] * W[row][i] for row in range(size)), domain.zero) for i in range(springs_count)] for k in range(size)]
+    springs = tuple(_classify(i, a0 * B[i][mode], gaps[i], digits, mode) for i in range(springs_count))
+    # Moving boundaries, increasing in angle.
+    boundaries, angles = [], []
+    for spring in sorted((s for s in springs if s.status == "crossing"), key=lambda s: s.kappa.context.acos(s.kappa)):
+        kappa = spring.kappa
+        angle = kappa.context.acos(kappa)
+        point = EvaluationPoint(domain, angle, kappa, kappa.context.sqrt((1 - kappa) * (1 + kappa)))
+        coupling = tuple(a0 * B[spring.index][k] for k in range(size))
+        boundaries.append((spring, MovingBoundary(point, coupling, point.sin_multiple(1))))
+        angles.append(angle)
+    pi = domain.convert(sympy.N(sympy.pi, digits + 10))
+    # One contact state per piece: a sample angle inside it decides the active springs.
+    limits = [domain.zero] + angles + [pi]
+    states = []
+    for lower, upper in zip(limits, limits[1:]):
+        middle = (lower + upper) / 2
+        cosine = middle.context.cos(middle)
+        active = [
+            s.index
+            for s in springs
+            if s.status == "always" or (s.status == "crossing" and ((cosine > s.kappa) if s.orientation > 0 else (cosine < s.kappa)))
+        ]
+        stiffness = tuple(tuple(sum((G[k][i] * B[i][l] for i in active), domain.zero) for l in range(size)) for k in range(size))
+        load = tuple(-sum((G[k][i] * gaps[i] for i in active), domain.zero) / a0 for k in range(size))
+        states.append(ContactState(stiffness, load))
+    branch_system = BranchSystem(
+        domain=domain,
+        ratios=tuple(None if k == mode else ratio for k, ratio in enumerate(ratios)),
+        mode=mode,
+        states=tuple(states),
+        boundaries=tuple(boundary for _, boundary in boundaries),
+        zero_point=EvaluationPoint(domain, domain.zero, domain.one, domain.zero),
+        pi_point=EvaluationPoint(domain, pi, -domain.one, domain.zero),
+        release=convert(release_correction) * lam * lam / a0,
+    )
+    return ModalNormalForm(branch_system, digits, tuple(frequencies), a0, springs, small_divisors)
