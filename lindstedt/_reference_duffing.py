@@ -74,8 +74,8 @@ from sympy.polys.ring_series import (
 )
 from sympy.polys.rings import ring
 
-from ._errors import ConvergenceError, OrderError, ProblemError
-from ._reference_quadrature import real_parameter, validate_dps
+from ._errors import ConvergenceError, ProblemError
+from ._reference_quadrature import omega0_parameter, real_parameter, validate_dps, validate_order
 
 __all__ = ["duffing_exact_frequency", "duffing_frequency_taylor"]
 
@@ -271,10 +271,8 @@ def duffing_exact_frequency(
     with mpmath.workdps(dps + 10):
         epsilon_value = real_parameter(epsilon, "epsilon")
         amplitude_value = real_parameter(amplitude, "amplitude")
-        omega0_value = real_parameter(omega0, "omega0")
+        omega0_value = omega0_parameter(omega0)
         coefficient_value = real_parameter(coefficient, "coefficient")
-        if omega0_value <= 0:
-            raise ProblemError(f"omega0 = {omega0} must be positive")
         strength = mpmath.fmul(epsilon_value, coefficient_value, exact=True)
         if normalization == "harmonic":
             x, one_plus_x = _strength_from_harmonic(amplitude_value, strength, omega0_value)
@@ -283,16 +281,6 @@ def duffing_exact_frequency(
         frequency = _frequency(x, one_plus_x, omega0_value)
     with mpmath.workdps(dps):
         return +frequency
-
-
-def _validate_order(order: Any) -> int:
-    if isinstance(order, bool) or not isinstance(order, int):
-        raise OrderError(f"order must be an int, got {order!r}")
-    if order < 0:
-        raise OrderError(f"order must be >= 0, got {order}")
-    if order > _MAXIMUM_TAYLOR_ORDER:
-        raise OrderError(f"order {order} exceeds the supported maximum {_MAXIMUM_TAYLOR_ORDER}")
-    return order
 
 
 def _coefficients(series: Any, order: int) -> tuple[sympy.Rational, ...]:
@@ -403,6 +391,6 @@ def duffing_frequency_taylor(order: int, normalization: str = "initial") -> list
     >>> duffing_frequency_taylor(2, "harmonic")
     [1, 3/8, -15/256]
     """
-    order = _validate_order(order)
+    order = validate_order(order, maximum=_MAXIMUM_TAYLOR_ORDER)
     normalization = _check_normalization(normalization)
     return list(_initial_taylor(order) if normalization == "initial" else _harmonic_taylor(order))

@@ -58,8 +58,15 @@ from typing import Any
 import mpmath
 import sympy
 
-from ._errors import ConvergenceError, OrderError, ProblemError
-from ._reference_quadrature import as_mpmath_number, real_parameter, validate_dps
+from ._errors import ConvergenceError, ProblemError
+from ._reference_quadrature import (
+    as_mpmath_number,
+    omega0_parameter,
+    real_parameter,
+    rounded_coefficients,
+    validate_dps,
+    validate_order,
+)
 
 __all__ = [
     "piecewise_linear_exact_period",
@@ -73,15 +80,7 @@ _MAXIMUM_TAYLOR_ORDER = 60
 
 
 def _parameters(a: Any, b: Any, a0: Any, omega0: Any) -> tuple[mpmath.mpf, mpmath.mpf, mpmath.mpf, mpmath.mpf]:
-    a_value, b_value, a0_value, omega0_value = (
-        real_parameter(a, "a"),
-        real_parameter(b, "b"),
-        real_parameter(a0, "a0"),
-        real_parameter(omega0, "omega0"),
-    )
-    if omega0_value <= 0:
-        raise ProblemError(f"omega0 = {omega0} must be positive")
-    return a_value, b_value, a0_value, omega0_value
+    return real_parameter(a, "a"), real_parameter(b, "b"), real_parameter(a0, "a0"), omega0_parameter(omega0)
 
 
 def _real_period(stiffness: mpmath.mpf, b: mpmath.mpf, a0: mpmath.mpf, omega0: mpmath.mpf) -> mpmath.mpf:
@@ -337,10 +336,7 @@ def piecewise_linear_frequency_taylor(
     >>> [mpmath.nstr(value, 15) for value, error in coefficients]  # 1, a/4, -a**2/8
     ['1.0', '0.25', '-0.125']
     """
-    if isinstance(order, bool) or not isinstance(order, int) or order < 0:
-        raise OrderError(f"order must be a non-negative int, got {order!r}")
-    if order > _MAXIMUM_TAYLOR_ORDER:
-        raise OrderError(f"order {order} exceeds the supported maximum {_MAXIMUM_TAYLOR_ORDER}")
+    order = validate_order(order, maximum=_MAXIMUM_TAYLOR_ORDER)
     dps = validate_dps(dps)
     working_dps = dps + 15
     with mpmath.workdps(working_dps):
@@ -357,10 +353,7 @@ def piecewise_linear_frequency_taylor(
                 results.append((value, abs(value) * mpmath.mpf(10) ** (-working_dps + 2)))
         else:
             results = _cauchy_coefficients(branch, order, working_dps)
-        # Rounding the result to dps digits adds up to one unit in the last digit.
-        results = [(value, error + abs(value) * mpmath.mpf(10) ** (-dps)) for value, error in results]
-    with mpmath.workdps(dps):
-        return [(+value, +error) for value, error in results]
+        return rounded_coefficients(results, dps)
 
 
 def _cauchy_coefficients(branch: _AnalyticBranch, order: int, working_dps: int) -> list[tuple[mpmath.mpf, mpmath.mpf]]:
@@ -439,23 +432,14 @@ def piecewise_linear_frequency_taylor_symbolic(
     >>> piecewise_linear_frequency_taylor_symbolic(2)
     -a**2*epsilon**2/(8*omega0**3) + a*epsilon/(4*omega0) + omega0
     """
-    if isinstance(order, bool) or not isinstance(order, int) or order < 0:
-        raise OrderError(f"order must be a non-negative int, got {order!r}")
-    if order > _MAXIMUM_TAYLOR_ORDER:
-        raise OrderError(f"order {order} exceeds the supported maximum {_MAXIMUM_TAYLOR_ORDER}")
+    order = validate_order(order, maximum=_MAXIMUM_TAYLOR_ORDER)
     epsilon_symbol = epsilon if epsilon is not None else sympy.Symbol("epsilon")
     a_symbol = a if a is not None else sympy.Symbol("a")
     omega0_symbol = omega0 if omega0 is not None else sympy.Symbol("omega0", positive=True)
-    # Closed form with b = 0: w_f = w_c = 0 in the crossing formula of the module docstring.
+    # Closed form with b = 0: w_f = w_c = 0 in the crossing formula of the module docstring,
+    # T omega0 = 2 (pi - arccos 0) + 2 arccos(0) / (Omega/omega0) = pi + pi / (Omega/omega0).
     scaled = sympy.Symbol("s")  # s = epsilon a / omega0**2
     contact_ratio = sympy.sqrt(1 + scaled)  # Omega / omega0
-    free_argument = sympy.Integer(0)
-    contact_argument = sympy.Integer(0)
-    period_times_omega0 = 2 * (sympy.pi - sympy.acos(free_argument)) + 2 * sympy.acos(contact_argument) / contact_ratio
-    frequency_ratio = 2 * sympy.pi / period_times_omega0
+    frequency_ratio = 2 * sympy.pi / (sympy.pi + sympy.pi / contact_ratio)
     series = sympy.series(frequency_ratio, scaled, 0, order + 1).removeO()
-    polynomial = sympy.Poly(sympy.expand(series), scaled)
-    result = sympy.Integer(0)
-    for (power,), coefficient in polynomial.terms():
-        result += omega0_symbol * coefficient * (epsilon_symbol * a_symbol / omega0_symbol**2) ** power
-    return sympy.expand(result)
+    return sympy.expand(omega0_symbol * series.subs(scaled, epsilon_symbol * a_symbol / omega0_symbol**2))

@@ -53,6 +53,7 @@ Nonlinearity = Union[sympy.Expr, Callable[[Any], Any]]
 
 _MAXIMUM_TRAPEZOID_NODES = 2**13
 _INITIAL_TRAPEZOID_NODES = 16
+_MAXIMUM_CHEBYSHEV_ORDER = 24
 # An angular offset that is not a dyadic fraction of 2 pi, so that no node of
 # any power-of-two trapezoid grid falls on the turning points theta = +-pi/2.
 _NODE_OFFSET_FRACTION = Fraction(1, 7)
@@ -134,6 +135,34 @@ def validate_dps(dps: Any) -> int:
     return dps
 
 
+def omega0_parameter(omega0: Any) -> mpmath.mpf:
+    """The linear angular frequency omega0: a real number (see :func:`real_parameter`) that must be positive."""
+    value = real_parameter(omega0, "omega0")
+    if value <= 0:
+        raise ProblemError(f"omega0 = {omega0} must be positive")
+    return value
+
+
+def validate_order(order: Any, maximum: int) -> int:
+    """Check a requested Taylor order (an int from 0 to ``maximum``)."""
+    if isinstance(order, bool) or not isinstance(order, int) or order < 0:
+        raise OrderError(f"order must be a non-negative int, got {order!r}")
+    if order > maximum:
+        raise OrderError(f"order {order} exceeds the supported maximum {maximum}")
+    return order
+
+
+def rounded_coefficients(results: list[tuple[mpmath.mpf, mpmath.mpf]], dps: int) -> list[tuple[mpmath.mpf, mpmath.mpf]]:
+    """``(value, error)`` pairs rounded to ``dps`` digits, each error grown by that rounding.
+
+    Call it at the working precision: rounding the result to dps digits adds up
+    to one unit in the last digit.
+    """
+    results = [(value, error + abs(value) * mpmath.mpf(10) ** (-dps)) for value, error in results]
+    with mpmath.workdps(dps):
+        return [(+value, +error) for value, error in results]
+
+
 class _Potential:
     """``V(u) = omega0**2 u**2/2 + epsilon F(u)`` and its slope, from f."""
 
@@ -176,6 +205,14 @@ class _Potential:
     def antiderivative(self, position: Any) -> Any:
         return mpmath.mpmathify(self._antiderivative(position))
 
+    def value(self, position: Any, epsilon: mpmath.mpf, omega0: mpmath.mpf) -> Any:
+        """``V(u) = omega0**2 u**2/2 + epsilon F(u)``."""
+        return omega0**2 * position**2 / 2 + epsilon * self.antiderivative(position)
+
+    def slope(self, position: Any, epsilon: mpmath.mpf, omega0: mpmath.mpf) -> Any:
+        """``V'(u) = omega0**2 u + epsilon f(u)``."""
+        return omega0**2 * position + epsilon * self.force(position)
+
 
 def _find_other_turning_point(
     potential: _Potential,
@@ -184,15 +221,8 @@ def _find_other_turning_point(
     omega0: mpmath.mpf,
 ) -> mpmath.mpf:
     """First point b past which the orbit released at rest from a0 cannot go."""
-
-    def potential_value(position: mpmath.mpf) -> mpmath.mpf:
-        return omega0**2 * position**2 / 2 + epsilon * potential.antiderivative(position)
-
-    def slope(position: mpmath.mpf) -> mpmath.mpf:
-        return omega0**2 * position + epsilon * potential.force(position)
-
-    energy = potential_value(a0)
-    initial_slope = slope(a0)
+    energy = potential.value(a0, epsilon, omega0)
+    initial_slope = potential.slope(a0, epsilon, omega0)
     scale = abs(a0) if a0 != 0 else mpmath.mpf(1)
     if abs(initial_slope) <= mpmath.eps * 1000 * omega0**2 * scale:
         raise ProblemError(
@@ -202,7 +232,7 @@ def _find_other_turning_point(
     direction = -1 if initial_slope > 0 else 1
 
     def excess(position: mpmath.mpf) -> mpmath.mpf:
-        return energy - potential_value(position)
+        return energy - potential.value(position, epsilon, omega0)
 
     # Scan in steps of |a0|/16 up to 4|a0| from the release point, then in geometric steps
     # (factor 5/4) up to 1e12 |a0|; the first sign change of V(a0) - V(u) brackets b.
@@ -235,7 +265,7 @@ def _find_other_turning_point(
             low = guess
         else:
             high = guess
-        derivative = -direction * slope(position)
+        derivative = -direction * potential.slope(position, epsilon, omega0)
         candidate = guess - value / derivative if derivative != 0 else low - 1
         if not low <= candidate <= high:
             candidate = (low + high) / 2
@@ -259,12 +289,12 @@ def _period_by_trapezoid(
     other_turning_point = _find_other_turning_point(potential, epsilon, a0, omega0)
     middle = (a0 + other_turning_point) / 2
     half_width = (a0 - other_turning_point) / 2
-    energy = omega0**2 * a0**2 / 2 + epsilon * potential.antiderivative(a0)
+    energy = potential.value(a0, epsilon, omega0)
     offset = 2 * mpmath.pi * _NODE_OFFSET_FRACTION.numerator / _NODE_OFFSET_FRACTION.denominator
 
     def integrand(angle: mpmath.mpf) -> mpmath.mpf:
         position = middle + half_width * mpmath.sin(angle)
-        excess = energy - (omega0**2 * position**2 / 2 + epsilon * potential.antiderivative(position))
+        excess = energy - potential.value(position, epsilon, omega0)
         reduced = excess / mpmath.cos(angle) ** 2
         if reduced <= 0:
             raise ConvergenceError(
@@ -305,9 +335,7 @@ def _period(
     with mpmath.workdps(dps + 20):
         epsilon_value = real_parameter(epsilon, "epsilon")
         a0_value = real_parameter(a0, "a0")
-        omega0_value = real_parameter(omega0, "omega0")
-        if omega0_value <= 0:
-            raise ProblemError(f"omega0 = {omega0} must be positive")
+        omega0_value = omega0_parameter(omega0)
         period, difference = _period_by_trapezoid(potential, epsilon_value, a0_value, omega0_value, dps + 5)
         error = difference + abs(period) * mpmath.mpf(10) ** (-dps)
     with mpmath.workdps(dps):
@@ -486,19 +514,14 @@ def frequency_taylor_coefficients(
     >>> [mpmath.nstr(value, 12) for value, error in coefficients]  # 1, 3/8, -21/256
     ['1.0', '0.375', '-0.08203125']
     """
-    if isinstance(order, bool) or not isinstance(order, int) or order < 0:
-        raise OrderError(f"order must be a non-negative int, got {order!r}")
-    if order > 24:
-        raise OrderError(f"order {order} is too high for the Chebyshev reference (at most 24)")
+    order = validate_order(order, maximum=_MAXIMUM_CHEBYSHEV_ORDER)
     dps = validate_dps(dps)
     potential = _Potential(f)
     fine_nodes = 64  # the coarse grid is every other node (33 points)
     working_dps = dps + 15
     with mpmath.workdps(working_dps):
         a0_value = real_parameter(a0, "a0")
-        omega0_value = real_parameter(omega0, "omega0")
-        if omega0_value <= 0:
-            raise ProblemError(f"omega0 = {omega0} must be positive")
+        omega0_value = omega0_parameter(omega0)
         radius = _characteristic_epsilon(potential, a0_value, omega0_value) / 8
         last_problem = "no attempt made"
         for _attempt in range(6):
@@ -524,10 +547,7 @@ def frequency_taylor_coefficients(
                 if error > mpmath.mpf(10) ** (-(dps // 2)) * max(magnitude / radius**power, abs(fine[power])):
                     acceptable = False
             if acceptable:
-                # Rounding the result to dps digits adds up to one unit in the last digit.
-                results = [(value, error + abs(value) * mpmath.mpf(10) ** (-dps)) for value, error in results]
-                with mpmath.workdps(dps):
-                    return [(+value, +error) for value, error in results]
+                return rounded_coefficients(results, dps)
             last_problem = "Chebyshev grids of 33 and 65 points disagree (the interval reaches a singularity)"
             radius /= 4
     raise ConvergenceError(

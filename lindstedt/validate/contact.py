@@ -89,12 +89,13 @@ def _band_intervals(times: np.ndarray, values: np.ndarray, low: float, high: flo
     pieces: list[tuple[float, float]] = []
 
     def edge(k: int, level: float) -> float:
+        """Where u crosses ``level`` strictly inside the step from times[k] to times[k + 1]."""
         t0, t1, u0, u1 = times[k], times[k + 1], values[k], values[k + 1]
-        if function is not None and (u0 - level) * (u1 - level) < 0:
-            counter[0] += 1
-            return float(scipy.optimize.brentq(lambda s: float(function(np.array([s]))[0]) - level, t0, t1,
-                                               xtol=4e-16 * max(1.0, abs(t1)), rtol=4 * np.finfo(float).eps))
-        return float(t0 + (level - u0) / (u1 - u0) * (t1 - t0)) if u1 != u0 else float(t0)
+        if function is None:
+            return float(t0 + (level - u0) / (u1 - u0) * (t1 - t0))
+        counter[0] += 1
+        return float(scipy.optimize.brentq(lambda s: float(function(np.array([s]))[0]) - level, t0, t1,
+                                           xtol=4e-16 * max(1.0, abs(t1)), rtol=4 * np.finfo(float).eps))
 
     segment_low = np.minimum(values[:-1], values[1:])
     segment_high = np.maximum(values[:-1], values[1:])
@@ -104,10 +105,7 @@ def _band_intervals(times: np.ndarray, values: np.ndarray, low: float, high: flo
             start, end = times[k], times[k + 1]
         else:
             # the band [low, high] meets the segment [u0, u1] on a sub-interval
-            crossings = []
-            for level in (low, high):
-                if (u0 - level) * (u1 - level) < 0:
-                    crossings.append(edge(k, level))
+            crossings = [edge(k, level) for level in (low, high) if (u0 - level) * (u1 - level) < 0]
             if inside[k]:
                 start, end = times[k], min(crossings) if crossings else times[k + 1]
             elif inside[k + 1]:
@@ -304,9 +302,7 @@ def fitted_contact_measure_order(
     if numeric.law is None or not numeric.law.breakpoints:
         raise ProblemError("the contact measure needs a piecewise-linear f with at least one breakpoint (a gap b)")
     levels = numeric.law.breakpoints
-    M = float(band_constant)
-    if not (math.isfinite(M) and M > 0):
-        raise ProblemError(f"band_constant M must be positive, got {band_constant!r}")
+    M = _as_positive(band_constant, "band_constant M")
     duration = float(periods) * 2 * math.pi / numeric.omega0
     n = max(1001, int(math.ceil(samples_per_period * float(periods))) + 1)
     times = np.linspace(0.0, duration, n)

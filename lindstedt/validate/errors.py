@@ -330,6 +330,11 @@ class _ErrorRuns:
         self.evaluations += result.n_evaluations
         return result
 
+    def totals(self) -> dict[str, int]:
+        """The counters, as the ``n_*`` fields of the fit results."""
+        return {"n_reference_solves": self.solves, "n_samples": self.samples, "n_switches": self.switches,
+                "n_evaluations": self.evaluations}
+
 
 # --------------------------------------------------------------------------- #
 # convergence order
@@ -457,16 +462,12 @@ def fitted_convergence_order(
             f"{[float(e) for e in eps_values[errors <= floor]]}: nothing to fit (e.g. grazing with a1 = 0 is exact)"
         )
     fit = _fit_or_nan(eps_values, errors)
-    success = not failures
-    if failures:
-        message = "; ".join(failures)
-    else:
-        message = (
-            f"slope {fit.slope:.4f} ± {fit.standard_error:.2g} over t ≤ {rule_name} "
-            f"(expected {expansion.order + 1} for simple contact or smooth f)"
-        )
+    message = "; ".join(failures) if failures else (
+        f"slope {fit.slope:.4f} ± {fit.standard_error:.2g} over t ≤ {rule_name} "
+        f"(expected {expansion.order + 1} for simple contact or smooth f)"
+    )
     return ConvergenceFit(
-        success=success,
+        success=not failures,
         message=message,
         slope=fit.slope,
         intercept=fit.intercept,
@@ -476,10 +477,7 @@ def fitted_convergence_order(
         max_errors=errors,
         t_ends=np.array(t_ends),
         t_end_rule=rule_name,
-        n_reference_solves=runs.solves,
-        n_samples=runs.samples,
-        n_switches=runs.switches,
-        n_evaluations=runs.evaluations,
+        **runs.totals(),
     )
 
 
@@ -639,9 +637,7 @@ def fitted_validity_exponent(
         constant = math.nan
         threshold_of = lambda eps: float(tolerance_rule(eps))  # noqa: E731
     else:
-        constant = float(tolerance_rule)
-        if not (math.isfinite(constant) and constant > 0):
-            raise ProblemError(f"the threshold constant C must be positive, got {tolerance_rule!r}")
+        constant = _as_positive(tolerance_rule, "the threshold constant C")
         threshold_of = lambda eps: constant * eps**power  # noqa: E731
 
     validity_times, thresholds, horizons = [], [], []
@@ -692,8 +688,5 @@ def fitted_validity_exponent(
         validity_times=times,
         thresholds=np.array(thresholds),
         horizons=np.array(horizons),
-        n_reference_solves=errors_on.solves,
-        n_samples=errors_on.samples,
-        n_switches=errors_on.switches,
-        n_evaluations=errors_on.evaluations,
+        **errors_on.totals(),
     )

@@ -53,16 +53,6 @@ DEFAULT_ATOL = 1e-14
 # --------------------------------------------------------------------------- #
 # input checks shared by lindstedt.validate
 # --------------------------------------------------------------------------- #
-def _as_epsilon(epsilon: Any) -> float:
-    try:
-        value = float(epsilon)
-    except (TypeError, ValueError):
-        raise ProblemError(f"epsilon must be a real number, got {epsilon!r}") from None
-    if not math.isfinite(value) or value < 0:
-        raise ProblemError(f"epsilon must be a finite non-negative number, got {epsilon!r}")
-    return value
-
-
 def _as_real(value: Any, name: str) -> float:
     try:
         return float(value)
@@ -70,11 +60,15 @@ def _as_real(value: Any, name: str) -> float:
         raise ProblemError(f"{name} must be a real number, got {value!r}") from None
 
 
+def _as_epsilon(epsilon: Any) -> float:
+    value = _as_real(epsilon, "epsilon")
+    if not math.isfinite(value) or value < 0:
+        raise ProblemError(f"epsilon must be a finite non-negative number, got {epsilon!r}")
+    return value
+
+
 def _as_positive(value: Any, name: str) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ProblemError(f"{name} must be a positive number, got {value!r}") from None
+    number = _as_real(value, name)
     if not (math.isfinite(number) and number > 0):
         raise ProblemError(f"{name} must be a positive finite number, got {value!r}")
     return number
@@ -129,19 +123,18 @@ def _numeric_problem(source: Oscillator | Expansion, values: Mapping[Any, Any] |
     omega0 = float(problem.omega0.xreplace(substitution))
     a0 = float(problem.a0.xreplace(substitution))
     nonlinearity = problem.nonlinearity.xreplace(substitution)
-    if problem.normalization == "harmonic":
-        if not isinstance(source, Expansion):
-            raise ProblemError(
-                "with normalization='harmonic' a0 is the first-harmonic amplitude, so u(0) depends on ε; "
-                "pass the Expansion (its u(0) is used) instead of the Oscillator"
-            )
+    if problem.normalization == "harmonic" and not isinstance(source, Expansion):
+        raise ProblemError(
+            "with normalization='harmonic' a0 is the first-harmonic amplitude, so u(0) depends on ε; "
+            "pass the Expansion (its u(0) is used) instead of the Oscillator"
+        )
     law = None
     if problem.is_non_smooth:
         try:
             intervals = decompose_piecewise_linear(nonlinearity, DISPLACEMENT)
         except UnsupportedNonlinearityError:
-            intervals = None
-        if intervals is not None:
+            pass  # non-smooth but not piecewise linear: DOP853 across the kinks
+        else:
             law = _PiecewiseLaw(
                 breakpoints=tuple(float(interval.upper) for interval in intervals[:-1]),
                 slopes=tuple(float(interval.slope) for interval in intervals),
@@ -279,16 +272,12 @@ def _piecewise_dop853(law: _PiecewiseLaw, omega0: float, epsilon: float, u0: flo
             return [y[1], -omega2 * y[0] - epsilon * (slope * y[0] + intercept)]
 
         events = []
-        if region > 0:
-            lower = law.breakpoints[region - 1]
-            event = lambda _t, y, lower=lower: y[0] - lower  # noqa: E731
-            event.terminal, event.direction = True, -1
-            events.append(event)
-        if region < len(law.breakpoints):
-            upper = law.breakpoints[region]
-            event = lambda _t, y, upper=upper: y[0] - upper  # noqa: E731
-            event.terminal, event.direction = True, 1
-            events.append(event)
+        # leaving the piece: down through its lower breakpoint or up through its upper one
+        for index, direction in ((region - 1, -1), (region, 1)):
+            if 0 <= index < len(law.breakpoints):
+                event = lambda _t, y, level=law.breakpoints[index]: y[0] - level  # noqa: E731
+                event.terminal, event.direction = True, direction
+                events.append(event)
         solution = solve_ivp(rhs, (t, t_end), [u, v], method="DOP853", rtol=rtol, atol=atol,
                              dense_output=True, events=events or None)
         n_evaluations += int(solution.nfev)

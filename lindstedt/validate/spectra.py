@@ -212,14 +212,10 @@ def spectrum(
     cycles: float | None = None
     fundamental_value: float | None = None
     if periods is not None:
-        cycles = float(periods)
-        if not (math.isfinite(cycles) and cycles > 0):
-            raise ProblemError(f"periods must be positive, got {cycles!r}")
+        cycles = _as_positive(periods, "periods")
         fundamental_value = 2 * math.pi * cycles / length
     elif fundamental is not None:
-        fundamental_value = float(fundamental)
-        if not (math.isfinite(fundamental_value) and fundamental_value > 0):
-            raise ProblemError(f"fundamental must be a positive angular frequency, got {fundamental!r}")
+        fundamental_value = _as_positive(fundamental, "fundamental (an angular frequency)")
         cycles = fundamental_value * length / (2 * math.pi)
     whole = cycles is not None and abs(cycles - round(cycles)) <= 1e-9 * max(1.0, cycles)
     if window is None:
