@@ -225,7 +225,7 @@ def _arrays(system: Any) -> dict:
     return {"M": system.M, "K": system.K, "A": system.A, "b": system.b, "W": system.W}
 
 
-def _own_unilateral_frequency(epsilon: float, kappa: Any, dps: int) -> Any:
+def _own_unilateral_frequency(epsilon: float, kappa: Any, precision: int) -> Any:
     """ω of u'' + u + ε (u − κ)_+ = 0, u(0) = 1 > κ, u'(0) = 0, from harmonic arcs (written here, independently).
 
     Contact arc: u = u* + (1 − u*) cos(ω_c t), u* = εκ/(1+ε), ω_c = √(1+ε), until u = κ at t₁ with velocity
@@ -234,7 +234,7 @@ def _own_unilateral_frequency(epsilon: float, kappa: Any, dps: int) -> Any:
     """
     import mpmath
 
-    with mpmath.workdps(dps + 15):
+    with mpmath.workdps(precision + 15):
         eps, k = mpmath.mpf(epsilon), mpmath.mpf(kappa.numerator) / kappa.denominator
         rest = eps * k / (1 + eps)
         omega_c = mpmath.sqrt(1 + eps)
@@ -261,8 +261,8 @@ def _worker_duffing(config: dict) -> dict:
     lindstedt.expand("u**3 + u**5", order=3, a0=1, omega0=1).frequency(0.1)  # warm the code paths (another f)
     out: dict[str, Any] = {"eps": {}}
     for epsilon in config["duffing_eps"]:
-        ref_elliptic = duffing_exact_frequency(epsilon, amplitude=1, dps=REFERENCE_DPS)
-        ref_quadrature, ref_quadrature_estimate = conservative_frequency(u**3, epsilon, a0=1, dps=REFERENCE_DPS - 10)
+        ref_elliptic = duffing_exact_frequency(epsilon, amplitude=1, precision=REFERENCE_DPS)
+        ref_quadrature, ref_quadrature_estimate = conservative_frequency(u**3, epsilon, a0=1, precision=REFERENCE_DPS - 10)
         entry: dict[str, Any] = {
             "reference_elliptic": mpmath.nstr(ref_elliptic, 40),
             "reference_quadrature": mpmath.nstr(ref_quadrature, 40),
@@ -295,14 +295,14 @@ def _worker_duffing(config: dict) -> dict:
                 "truncation_error": _mp_error(_exact_sum(expansion.omega, epsilon), ref_elliptic),
                 "validity_warning": any("converging" in str(w.message) for w in caught),
             })
-        for dps in config["duffing_dps"]:
-            seconds, value = _warm(lambda dps=dps: duffing_exact_frequency(epsilon, amplitude=1, dps=dps), repeats)
-            entry["elliptic"].append({"dps": dps, "seconds": seconds, "value": mpmath.nstr(value, dps + 5),
+        for precision in config["duffing_dps"]:
+            seconds, value = _warm(lambda precision=precision: duffing_exact_frequency(epsilon, amplitude=1, precision=precision), repeats)
+            entry["elliptic"].append({"precision": precision, "seconds": seconds, "value": mpmath.nstr(value, precision + 5),
                                       "error": _mp_error(value, ref_quadrature)})
-        for dps in config["duffing_dps"]:
+        for precision in config["duffing_dps"]:
             seconds, (value, estimate) = _warm(
-                lambda dps=dps: conservative_frequency(u**3, epsilon, a0=1, dps=dps), max(2, repeats // 2), 0.0)
-            entry["quadrature"].append({"dps": dps, "seconds": seconds, "value": mpmath.nstr(value, dps + 5),
+                lambda precision=precision: conservative_frequency(u**3, epsilon, a0=1, precision=precision), max(2, repeats // 2), 0.0)
+            entry["quadrature"].append({"precision": precision, "seconds": seconds, "value": mpmath.nstr(value, precision + 5),
                                         "error": _mp_error(value, ref_elliptic), "own_estimate": float(estimate)})
         for rtol in config["rtols"]:
             def dop853(rtol=rtol):
@@ -345,7 +345,7 @@ def _worker_unilateral(config: dict) -> dict:
     out: dict[str, Any] = {"eps": {}, "system": system.to_json_dict()}
     for epsilon in config["unilateral_eps"]:
         reference = _own_unilateral_frequency(epsilon, kappa, REFERENCE_DPS)
-        library = piecewise_linear_exact_frequency(epsilon, a=1, b=kappa, a0=1, dps=REFERENCE_DPS)
+        library = piecewise_linear_exact_frequency(epsilon, a=1, b=kappa, a0=1, precision=REFERENCE_DPS)
         entry: dict[str, Any] = {
             "reference_own_arcs": mpmath.nstr(reference, 40),
             "reference_library": mpmath.nstr(library, 40),
@@ -376,10 +376,10 @@ def _worker_unilateral(config: dict) -> dict:
                 "truncation_error": _mp_error(_exact_sum(expansion.omega, epsilon), reference),
                 "validity_warning": any("converging" in str(w.message) for w in caught),
             })
-        for dps in config["unilateral_dps"]:
+        for precision in config["unilateral_dps"]:
             seconds, value = _warm(
-                lambda dps=dps: piecewise_linear_exact_frequency(epsilon, a=1, b=kappa, a0=1, dps=dps), repeats)
-            entry["closed_form"].append({"dps": dps, "seconds": seconds, "value": mpmath.nstr(value, dps + 5),
+                lambda precision=precision: piecewise_linear_exact_frequency(epsilon, a=1, b=kappa, a0=1, precision=precision), repeats)
+            entry["closed_form"].append({"precision": precision, "seconds": seconds, "value": mpmath.nstr(value, precision + 5),
                                          "error": _mp_error(value, reference)})
         for tol in config["shooting_tols_1dof"]:
             seconds, result = _warm(
@@ -588,9 +588,9 @@ def _section_duffing(data: dict, quick: bool, figures: list[Path]) -> list[str]:
           "* **LP, frequency (warm)**: `expansion.frequency(ε)` on an expansion already computed (sympy rationals "
           "→ floats → `polyval`, plus the ω_{N+1} ε^{N+1} warning check); *lambdified*: a call of "
           "`expansion.lambdify(\"frequency\")` (sympy-generated Python, built once untimed), ε → float.",
-          "* **elliptic**: `_reference_duffing.duffing_exact_frequency(ε, amplitude=1, dps=d)` (π√(1+ε)/(2K(m))), "
+          "* **elliptic**: `_reference_duffing.duffing_exact_frequency(ε, amplitude=1, precision=d)` (π√(1+ε)/(2K(m))), "
           "one call.",
-          "* **quadrature**: `_reference_quadrature.conservative_frequency(u**3, ε, a0=1, dps=d)` (period from the "
+          "* **quadrature**: `_reference_quadrature.conservative_frequency(u**3, ε, a0=1, precision=d)` (period from the "
           "energy integral by a refined trapezoid rule), one call; its own error estimate in the notes.",
           "* **DOP853**: `scipy.integrate.solve_ivp(method=\"DOP853\", rtol, atol = rtol·1e-3)` from (1, 0) with a "
           "terminal event at u' = 0 (upward crossing: the turning point u = −1 at t = T/2), ω = π / t½; one call.",
@@ -615,10 +615,10 @@ def _section_duffing(data: dict, quick: bool, figures: list[Path]) -> list[str]:
             w.append(f"| LP expand + frequency (cold) | N = {r['order']} | {_t(r['seconds_cold'])} | "
                      f"{_t(r['seconds_eval'])} | {_t(r['seconds_lambdified'])} | {_g(r['error'])} | {note} |")
         for r in entry["elliptic"]:
-            w.append(f"| elliptic closed form | dps = {r['dps']} | {_t(r['seconds'])} | — | — | {_g(r['error'])} | "
+            w.append(f"| elliptic closed form | precision = {r['precision']} | {_t(r['seconds'])} | — | — | {_g(r['error'])} | "
                      "vs quadrature reference |")
         for r in entry["quadrature"]:
-            w.append(f"| quadrature | dps = {r['dps']} | {_t(r['seconds'])} | — | — | {_g(r['error'])} | "
+            w.append(f"| quadrature | precision = {r['precision']} | {_t(r['seconds'])} | — | — | {_g(r['error'])} | "
                      f"own estimate {_g(r['own_estimate'])} |")
         for r in entry["dop853"]:
             w.append(f"| DOP853, event u' = 0 | rtol = {r['rtol']:.0e} | {_t(r['seconds'])} | — | — | {_g(r['error'])} | "
@@ -637,15 +637,15 @@ def _section_duffing(data: dict, quick: bool, figures: list[Path]) -> list[str]:
             (_log10([r["seconds_lambdified"] for r in lp]), _log10([r["error_lambdified"] for r in lp]),
              f"LP lambdified ω(ε), warm, N = {orders[0]}…{orders[-1]}"),
             (_log10([r["seconds"] for r in entry["elliptic"]]), _log10([r["error"] for r in entry["elliptic"]]),
-             "elliptic closed form, dps " + _span([r["dps"] for r in entry["elliptic"]])),
+             "elliptic closed form, precision " + _span([r["precision"] for r in entry["elliptic"]])),
             (_log10([r["seconds"] for r in entry["quadrature"]]), _log10([r["error"] for r in entry["quadrature"]]),
-             "quadrature, dps " + _span([r["dps"] for r in entry["quadrature"]])),
+             "quadrature, precision " + _span([r["precision"] for r in entry["quadrature"]])),
             (_log10([r["seconds"] for r in entry["dop853"]]), _log10([r["error"] for r in entry["dop853"]]),
              "DOP853, rtol " + _span([r["rtol"] for r in entry["dop853"]], _e0)),
         ]
         _figure(path, curves, title=f"Duffing frequency, ε = {key}: error vs run time" + (" (quick)" if quick else ""),
                 x_label="log10 run time (s)", y_label="log10 |ω − ω_ref|",
-                notes=["each curve: one point per order / dps / tolerance", "connected in that order"])
+                notes=["each curve: one point per order / precision / tolerance", "connected in that order"])
         figures.append(path)
         w += [f"![Duffing, ε = {key}: error against run time]({_rel(path)})", ""]
     return w
@@ -660,7 +660,7 @@ def _section_unilateral(data: dict, quick: bool, figures: list[Path]) -> list[st
           ".frequency(ε)` (30-digit floats), caches dropped as in problem 1 (a warm-up with κ = 1/4 ran first); "
           "*evaluation only* is `.frequency(ε)` on the computed expansion, or a call of its `lambdify(\"frequency\")`; "
           "notes as in problem 1.",
-          "* **closed form**: `_reference_piecewise.piecewise_linear_exact_frequency(ε, a=1, b=1/3, a0=1, dps=d)`.",
+          "* **closed form**: `_reference_piecewise.piecewise_linear_exact_frequency(ε, a=1, b=1/3, a0=1, precision=d)`.",
           "* **shooting**: `lindstedt.nnm_point(UnilateralSystem.one_dof(1, a=1, b=\"1/3\"), ε, 1, "
           "modal_amplitude=1.0, tol=…, verify_tol=1.0)` — `one_dof(ω0, a, b)` is `u'' + ω0² u + ε (a u − b)_+`, "
           "so a = 1, b = 1/3 is this problem, and modal amplitude 1 is u(0) = 1 (M = [[1]]). Newton on the exact "
@@ -690,7 +690,7 @@ def _section_unilateral(data: dict, quick: bool, figures: list[Path]) -> list[st
             w.append(f"| expansion (numeric) + frequency (cold) | N = {r['order']} | {_t(r['seconds_cold'])} | "
                      f"{_t(r['seconds_eval'])} | {_t(r['seconds_lambdified'])} | {_g(r['error'])} | {note} |")
         for r in entry["closed_form"]:
-            w.append(f"| closed form (library) | dps = {r['dps']} | {_t(r['seconds'])} | — | — | {_g(r['error'])} | |")
+            w.append(f"| closed form (library) | precision = {r['precision']} | {_t(r['seconds'])} | — | — | {_g(r['error'])} | |")
         for r in entry["shooting"]:
             w.append(f"| shooting `nnm_point` | tol = {r['tol']:.0e} | {_t(r['seconds'])} | — | — | {_g(r['error'])} | "
                      f"{r['iterations']} Newton it., {r['flows']} flows, residual {_g(r['residual'])}"
@@ -714,7 +714,7 @@ def _section_unilateral(data: dict, quick: bool, figures: list[Path]) -> list[st
             (_log10([r["seconds_lambdified"] for r in ex]), _log10([r["error_lambdified"] for r in ex]),
              f"expansion lambdified ω(ε), warm, N = {orders[0]}…{orders[-1]}"),
             (_log10([r["seconds"] for r in entry["closed_form"]]), _log10([r["error"] for r in entry["closed_form"]]),
-             "closed form, dps " + _span([r["dps"] for r in entry["closed_form"]])),
+             "closed form, precision " + _span([r["precision"] for r in entry["closed_form"]])),
             (_log10([r["seconds"] for r in shooting]), _log10([r["error"] for r in shooting], PLOT_FLOOR),
              "shooting nnm_point, tol " + _span([r["tol"] for r in shooting], _e0)),
             (_log10([r["seconds"] for r in entry["dop853_restart"]]),
@@ -724,7 +724,7 @@ def _section_unilateral(data: dict, quick: bool, figures: list[Path]) -> list[st
         ]
         _figure(path, curves, title=f"Unilateral spring κ = 1/3, ε = {key}: error vs run time"
                 + (" (quick)" if quick else ""), x_label="log10 run time (s)", y_label="log10 |ω − ω_ref|",
-                notes=["each curve: one point per order / dps / tolerance", "connected in that order"])
+                notes=["each curve: one point per order / precision / tolerance", "connected in that order"])
         figures.append(path)
         w += [f"![Unilateral spring, ε = {key}: error against run time]({_rel(path)})", ""]
     return w

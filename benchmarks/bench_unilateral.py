@@ -320,19 +320,19 @@ def _worker_series(kappa_text: str, truncations: list[int], mp_truncations: list
         seconds, value = _min_time(mp_run, 2)
         rows.append({"method": "truncated", "arithmetic": "mpmath, 30 digits", "terms": n, "seconds": seconds,
                      "value": _mp_text(value)})
-    for dps in dps_list:
+    for precision in dps_list:
         series = _MpSeries(kappa)
         start = time.perf_counter()
         try:
-            estimate = series_sum(series.term, start=2, dps=dps)
-            with mpmath.workdps(dps + 10):
+            estimate = series_sum(series.term, start=2, precision=precision)
+            with mpmath.workdps(precision + 10):
                 value = series.omega2_from(estimate.value)
             seconds = time.perf_counter() - start
-            rows.append({"method": "series_sum", "arithmetic": f"mpmath, dps={dps}", "terms": estimate.terms_used,
+            rows.append({"method": "series_sum", "arithmetic": f"mpmath, precision={precision}", "terms": estimate.terms_used,
                          "seconds": seconds, "value": _mp_text(value), "accel": estimate.method,
                          "error_estimate": float(estimate.error_estimate / 2)})
         except Exception as error:  # ConvergenceError: report it
-            rows.append({"method": "series_sum", "arithmetic": f"mpmath, dps={dps}", "terms": None,
+            rows.append({"method": "series_sum", "arithmetic": f"mpmath, precision={precision}", "terms": None,
                          "seconds": time.perf_counter() - start, "value": None,
                          "failure": f"{type(error).__name__}: {str(error)[:160]}"})
     # closed forms
@@ -398,7 +398,7 @@ def _reference(kappa: Fraction, order: int) -> list[tuple[Any, Any]]:
 
     with mpmath.workdps(REFERENCE_DPS + 20):
         b = mpmath.mpf(kappa.numerator) / kappa.denominator
-        return piecewise_linear_frequency_taylor(order, a=1, b=b, a0=1, omega0=1, dps=REFERENCE_DPS)
+        return piecewise_linear_frequency_taylor(order, a=1, b=b, a0=1, omega0=1, precision=REFERENCE_DPS)
 
 
 def _relative_error(value: Any, reference: Any) -> float:
@@ -719,7 +719,7 @@ def run(quick: bool = False) -> str:
     w("* *truncated, float*: harmonics k = 2…N of the series above in NumPy doubles (vectorised over k; the "
       "coefficients are computed inside the timed call); min of several calls.")
     w("* *truncated, mpmath*: the same series summed term by term at 30 digits (sines cached: one `sin` per k).")
-    w("* *`series_sum`*: `lindstedt.algebra.series_sum(term, start=2, dps=D)` — `mpmath.nsum` (Richardson + Shanks) "
+    w("* *`series_sum`*: `lindstedt.algebra.series_sum(term, start=2, precision=D)` — `mpmath.nsum` (Richardson + Shanks) "
       "checked by a second sum at 10 more digits; its own error estimate is shown.")
     w("* *numeric engine*: `lindstedt.expand(..., numeric=True, precision=30)` at order 2 for a new κ after a "
       "warm-up call (as in table 1).")

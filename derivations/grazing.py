@@ -80,7 +80,7 @@ def derive(order: int) -> common.Sheet:
         # the truncated omega(eps) = sum_k omega_k eps^k (omega0 = 1) against the exact frequency
         rows, worst = [], 0.0
         for epsilon in EPSILONS:
-            exact = references.piecewise_linear_exact_frequency(epsilon, a=1, b=b, a0=1, omega0=1, dps=DIGITS)
+            exact = references.piecewise_linear_exact_frequency(epsilon, a=1, b=b, a0=1, omega0=1, precision=DIGITS)
             truncated = sum(omega_k.subs(OMEGA0, 1) * sympy.Rational(epsilon) ** k for k, omega_k in enumerate(expansion.omega))
             approximate = mpmath.mpf(str(sympy.N(truncated, DIGITS)))
             difference = exact - approximate

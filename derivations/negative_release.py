@@ -68,7 +68,7 @@ def derive(order: int) -> common.Sheet:
     # check: the Taylor coefficients of the exact frequency 2 pi / period, by a Cauchy integral
     with mpmath.workdps(REFERENCE_DIGITS):
         reference = references.piecewise_linear_frequency_taylor(
-            order, a=1, b=sympy.Rational(1, 3), a0=-1, omega0=1, dps=REFERENCE_DIGITS
+            order, a=1, b=sympy.Rational(1, 3), a0=-1, omega0=1, precision=REFERENCE_DIGITS
         )
         difference = max(abs(mpmath.mpf(str(sympy.N(omega_k, REFERENCE_DIGITS))) - reference[k][0])
                          for k, omega_k in enumerate(expansion.omega))

@@ -93,7 +93,7 @@ def run_demo(order: int = 8, figure_path: str | None = None) -> str:
     lines.append(f"   derived in {elapsed * 1e3:.0f} ms; contact angle beta = {gap.contact_angles[0]}")
     lines.append(f"     omega_1 = {sympy.simplify(gap_omegas[1])}")
     with mpmath.workdps(40):
-        reference_values = piecewise_linear_frequency_taylor(4, a=1, b=mpmath.mpf(1) / 3, a0=1, dps=40)
+        reference_values = piecewise_linear_frequency_taylor(4, a=1, b=mpmath.mpf(1) / 3, a0=1, precision=40)
         worst = 0.0
         for k in range(1, 5):
             value, _ = reference_values[k]

@@ -272,7 +272,7 @@ class StrainedCoordinatesNNM:
         )
 
 
-def release_amplitudes_by_series(system: UnilateralSystem, mode: int, a0: Any, *, dps: int = 30) -> list[tuple[Any, Any]]:
+def release_amplitudes_by_series(system: UnilateralSystem, mode: int, a0: Any, *, precision: int = 30) -> list[tuple[Any, Any]]:
     """The a_k (k ≠ j) of Corollary 4.2 as Fourier series, summed by mpmath with an error estimate.
 
     Order one of mode k ≠ j: ``λ_j² v'' + λ_k² v = −Σ_i G_ki (a0 B_ij cos s − b_i)_+`` with the
@@ -309,11 +309,11 @@ def release_amplitudes_by_series(system: UnilateralSystem, mode: int, a0: Any, *
                 if coupling[i] == 0:
                     continue
                 sign = 1 if coupling[i] > 0 else (-1) ** harmonic
-                ramp = contact_ramp_coefficient_mp(harmonic, gaps[i] / abs(coupling[i]), dps=dps)
+                ramp = contact_ramp_coefficient_mp(harmonic, gaps[i] / abs(coupling[i]), precision=precision)
                 total += -forcing[k, i] * abs(coupling[i]) * sign * ramp
             return total / (frequencies[k] ** 2 - harmonic**2 * frequencies[j] ** 2)
 
-        estimate = series_sum(term, start=0, dps=dps)
+        estimate = series_sum(term, start=0, precision=precision)
         results.append((estimate.value, estimate.error_estimate))
     return results
 

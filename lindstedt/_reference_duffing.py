@@ -75,7 +75,7 @@ from sympy.polys.ring_series import (
 from sympy.polys.rings import ring
 
 from ._errors import ConvergenceError, ProblemError
-from ._reference_quadrature import omega0_parameter, real_parameter, validate_dps, validate_order
+from ._reference_quadrature import omega0_parameter, real_parameter, validate_precision, validate_order
 
 __all__ = ["duffing_exact_frequency", "duffing_frequency_taylor"]
 
@@ -223,7 +223,7 @@ def duffing_exact_frequency(
     omega0: Any = 1,
     coefficient: Any = 1,
     normalization: str = "initial",
-    dps: int = 30,
+    precision: int = 30,
 ) -> mpmath.mpf:
     """Exact angular frequency of ``u'' + omega0**2 u + epsilon c u**3 = 0``.
 
@@ -241,7 +241,7 @@ def duffing_exact_frequency(
         ``c``; the cubic term is ``epsilon * c * u**3``.
     normalization : {"initial", "harmonic"}
         Meaning of ``amplitude``.
-    dps : int, optional
+    precision : int, optional
         Decimal digits of the result (the global mpmath precision is untouched).
 
     Returns
@@ -259,16 +259,16 @@ def duffing_exact_frequency(
     Examples
     --------
     >>> import mpmath
-    >>> print(duffing_exact_frequency(0, amplitude=1, omega0=2, dps=15))
+    >>> print(duffing_exact_frequency(0, amplitude=1, omega0=2, precision=15))
     2.0
-    >>> mpmath.nstr(duffing_exact_frequency(1, amplitude=1, dps=25), 20)
+    >>> mpmath.nstr(duffing_exact_frequency(1, amplitude=1, precision=25), 20)
     '1.3177760649655266261'
-    >>> mpmath.nstr(duffing_exact_frequency("0.1", amplitude=1, normalization="harmonic", dps=25), 20)
+    >>> mpmath.nstr(duffing_exact_frequency("0.1", amplitude=1, normalization="harmonic", precision=25), 20)
     '1.036928728956429301'
     """
     normalization = _check_normalization(normalization)
-    dps = validate_dps(dps)
-    with mpmath.workdps(dps + 10):
+    precision = validate_precision(precision)
+    with mpmath.workdps(precision + 10):
         epsilon_value = real_parameter(epsilon, "epsilon")
         amplitude_value = real_parameter(amplitude, "amplitude")
         omega0_value = omega0_parameter(omega0)
@@ -279,7 +279,7 @@ def duffing_exact_frequency(
         else:
             x, one_plus_x = _strength_pair(strength, abs(amplitude_value), omega0_value)
         frequency = _frequency(x, one_plus_x, omega0_value)
-    with mpmath.workdps(dps):
+    with mpmath.workdps(precision):
         return +frequency
 
 
@@ -301,10 +301,10 @@ def _hypergeometric_half_half_one(order: int) -> list[Any]:
 
 @functools.lru_cache(maxsize=64)
 def _initial_taylor(order: int) -> tuple[sympy.Rational, ...]:
-    x, precision = _X, order + 1  # ring_series truncates at O(x**precision)
-    parameter = rs_mul(x, rs_series_inversion(1 + x, x, precision), x, precision) * QQ(1, 2)  # m = x/(2(1+x))
-    complete_integral = rs_series_from_list(parameter, _hypergeometric_half_half_one(order), x, precision)
-    ratio = rs_mul(rs_nth_root(1 + x, 2, x, precision), rs_series_inversion(complete_integral, x, precision), x, precision)
+    x, truncation = _X, order + 1  # ring_series truncates at O(x**truncation)
+    parameter = rs_mul(x, rs_series_inversion(1 + x, x, truncation), x, truncation) * QQ(1, 2)  # m = x/(2(1+x))
+    complete_integral = rs_series_from_list(parameter, _hypergeometric_half_half_one(order), x, truncation)
+    ratio = rs_mul(rs_nth_root(1 + x, 2, x, truncation), rs_series_inversion(complete_integral, x, truncation), x, truncation)
     return _coefficients(ratio, order)
 
 
@@ -348,18 +348,18 @@ def _reversion(series: Any, order: int) -> Any:
 def _harmonic_taylor(order: int) -> tuple[sympy.Rational, ...]:
     if order == 0:
         return (sympy.Integer(1),)
-    q, precision = _X, order + 1  # ring_series truncates at O(q**precision)
+    q, truncation = _X, order + 1  # ring_series truncates at O(q**truncation)
     theta3, psi = _theta_series(order)
-    theta3_squared_inverse = rs_series_inversion(rs_square(theta3, q, precision), q, precision)
-    psi_squared = rs_square(psi, q, precision)
-    parameter = rs_mul(q, rs_square(rs_mul(psi_squared, theta3_squared_inverse, q, precision), q, precision), q, precision) * 16  # m(q)
+    theta3_squared_inverse = rs_series_inversion(rs_square(theta3, q, truncation), q, truncation)
+    psi_squared = rs_square(psi, q, truncation)
+    parameter = rs_mul(q, rs_square(rs_mul(psi_squared, theta3_squared_inverse, q, truncation), q, truncation), q, truncation) * 16  # m(q)
     one_minus_two_m = 1 - 2 * parameter
-    strength = rs_mul(2 * parameter, rs_series_inversion(one_minus_two_m, q, precision), q, precision)  # x(q) = 2m/(1-2m)
-    frequency_ratio = rs_mul(rs_nth_root(one_minus_two_m, -2, q, precision), theta3_squared_inverse, q, precision)
-    amplitude_ratio = rs_series_inversion(rs_mul(1 + q, psi_squared, q, precision), q, precision)  # A1/A
-    harmonic_strength = rs_mul(strength, rs_square(amplitude_ratio, q, precision), q, precision)  # y(q)
+    strength = rs_mul(2 * parameter, rs_series_inversion(one_minus_two_m, q, truncation), q, truncation)  # x(q) = 2m/(1-2m)
+    frequency_ratio = rs_mul(rs_nth_root(one_minus_two_m, -2, q, truncation), theta3_squared_inverse, q, truncation)
+    amplitude_ratio = rs_series_inversion(rs_mul(1 + q, psi_squared, q, truncation), q, truncation)  # A1/A
+    harmonic_strength = rs_mul(strength, rs_square(amplitude_ratio, q, truncation), q, truncation)  # y(q)
     nome_of_y = _reversion(harmonic_strength, order)
-    frequency = rs_series_from_list(nome_of_y, list(_coefficients(frequency_ratio, order)), q, precision)
+    frequency = rs_series_from_list(nome_of_y, list(_coefficients(frequency_ratio, order)), q, truncation)
     return _coefficients(frequency, order)
 
 

@@ -64,7 +64,7 @@ from ._reference_quadrature import (
     omega0_parameter,
     real_parameter,
     rounded_coefficients,
-    validate_dps,
+    validate_precision,
     validate_order,
 )
 
@@ -195,7 +195,7 @@ def piecewise_linear_exact_period(
     b: Any,
     a0: Any,
     omega0: Any = 1,
-    dps: int = 30,
+    precision: int = 30,
 ) -> mpmath.mpf | mpmath.mpc:
     """Exact period of ``u'' + omega0**2 u + epsilon a (u - b)_+ = 0``, ``u(0) = a0``, ``u'(0) = 0``.
 
@@ -213,7 +213,7 @@ def piecewise_linear_exact_period(
         Release position (either sign).
     omega0 : positive real number, optional
         Free angular frequency.
-    dps : int, optional
+    precision : int, optional
         Decimal digits of the result.
 
     Returns
@@ -231,13 +231,13 @@ def piecewise_linear_exact_period(
     Examples
     --------
     >>> import mpmath
-    >>> mpmath.nstr(piecewise_linear_exact_period(3, a=1, b=0, a0=1, dps=20), 15)  # pi + pi/2
+    >>> mpmath.nstr(piecewise_linear_exact_period(3, a=1, b=0, a0=1, precision=20), 15)  # pi + pi/2
     '4.71238898038469'
-    >>> mpmath.nstr(piecewise_linear_exact_period(3, a=1, b=2, a0=1, dps=20), 15)  # no contact: 2 pi
+    >>> mpmath.nstr(piecewise_linear_exact_period(3, a=1, b=2, a0=1, precision=20), 15)  # no contact: 2 pi
     '6.28318530717959'
     """
-    dps = validate_dps(dps)
-    with mpmath.workdps(dps + 10):
+    precision = validate_precision(precision)
+    with mpmath.workdps(precision + 10):
         a_value, b_value, a0_value, omega0_value = _parameters(a, b, a0, omega0)
         epsilon_value = as_mpmath_number(epsilon, "epsilon")
         if isinstance(epsilon_value, mpmath.mpc) and epsilon_value.imag == 0:
@@ -255,7 +255,7 @@ def piecewise_linear_exact_period(
             period = branch.period(epsilon_value)
         else:
             period = _real_period(epsilon_value * a_value, b_value, a0_value, omega0_value)
-    with mpmath.workdps(dps):
+    with mpmath.workdps(precision):
         return +period
 
 
@@ -266,7 +266,7 @@ def piecewise_linear_exact_frequency(
     b: Any,
     a0: Any,
     omega0: Any = 1,
-    dps: int = 30,
+    precision: int = 30,
 ) -> mpmath.mpf | mpmath.mpc:
     """Exact angular frequency ``2 pi / T`` of ``u'' + omega0**2 u + epsilon a (u - b)_+ = 0``.
 
@@ -275,14 +275,14 @@ def piecewise_linear_exact_frequency(
     Examples
     --------
     >>> import mpmath
-    >>> mpmath.nstr(piecewise_linear_exact_frequency(3, a=1, b=0, a0=-2, dps=20), 15)  # 2*1*2/(1+2)
+    >>> mpmath.nstr(piecewise_linear_exact_frequency(3, a=1, b=0, a0=-2, precision=20), 15)  # 2*1*2/(1+2)
     '1.33333333333333'
     """
-    dps = validate_dps(dps)
-    with mpmath.workdps(dps + 10):
-        period = piecewise_linear_exact_period(epsilon, a=a, b=b, a0=a0, omega0=omega0, dps=dps + 10)
+    precision = validate_precision(precision)
+    with mpmath.workdps(precision + 10):
+        period = piecewise_linear_exact_period(epsilon, a=a, b=b, a0=a0, omega0=omega0, precision=precision + 10)
         frequency = 2 * mpmath.pi / period
-    with mpmath.workdps(dps):
+    with mpmath.workdps(precision):
         return +frequency
 
 
@@ -293,7 +293,7 @@ def piecewise_linear_frequency_taylor(
     b: Any,
     a0: Any,
     omega0: Any = 1,
-    dps: int = 40,
+    precision: int = 40,
 ) -> list[tuple[mpmath.mpf, mpmath.mpf]]:
     """Taylor coefficients ``omega_k`` of the exact frequency at ``epsilon = 0``.
 
@@ -316,7 +316,7 @@ def piecewise_linear_frequency_taylor(
         Contact stiffness coefficient, threshold, release position.
     omega0 : positive real number, optional
         Free angular frequency.
-    dps : int, optional
+    precision : int, optional
         Working digits.
 
     Returns
@@ -332,13 +332,13 @@ def piecewise_linear_frequency_taylor(
     Examples
     --------
     >>> import mpmath
-    >>> coefficients = piecewise_linear_frequency_taylor(2, a=1, b=0, a0=1, omega0=1, dps=30)
+    >>> coefficients = piecewise_linear_frequency_taylor(2, a=1, b=0, a0=1, omega0=1, precision=30)
     >>> [mpmath.nstr(value, 15) for value, error in coefficients]  # 1, a/4, -a**2/8
     ['1.0', '0.25', '-0.125']
     """
     order = validate_order(order, maximum=_MAXIMUM_TAYLOR_ORDER)
-    dps = validate_dps(dps)
-    working_dps = dps + 15
+    precision = validate_precision(precision)
+    working_dps = precision + 15
     with mpmath.workdps(working_dps):
         a_value, b_value, a0_value, omega0_value = _parameters(a, b, a0, omega0)
         branch = _AnalyticBranch(a_value, b_value, a0_value, omega0_value)
@@ -353,7 +353,7 @@ def piecewise_linear_frequency_taylor(
                 results.append((value, abs(value) * mpmath.mpf(10) ** (-working_dps + 2)))
         else:
             results = _cauchy_coefficients(branch, order, working_dps)
-        return rounded_coefficients(results, dps)
+        return rounded_coefficients(results, precision)
 
 
 def _cauchy_coefficients(branch: _AnalyticBranch, order: int, working_dps: int) -> list[tuple[mpmath.mpf, mpmath.mpf]]:

@@ -122,17 +122,17 @@ def real_parameter(value: Any, name: str) -> mpmath.mpf:
     return number
 
 
-def validate_dps(dps: Any) -> int:
+def validate_precision(precision: Any) -> int:
     """Check a requested number of decimal digits (an int >= 5).
 
     Examples
     --------
-    >>> validate_dps(30)
+    >>> validate_precision(30)
     30
     """
-    if isinstance(dps, bool) or not isinstance(dps, int) or not 5 <= dps <= 5000:
-        raise ProblemError(f"dps (decimal digits of precision) must be an int between 5 and 5000, got {dps!r}")
-    return dps
+    if isinstance(precision, bool) or not isinstance(precision, int) or not 5 <= precision <= 5000:
+        raise ProblemError(f"precision (decimal digits of precision) must be an int between 5 and 5000, got {precision!r}")
+    return precision
 
 
 def omega0_parameter(omega0: Any) -> mpmath.mpf:
@@ -152,14 +152,14 @@ def validate_order(order: Any, maximum: int) -> int:
     return order
 
 
-def rounded_coefficients(results: list[tuple[mpmath.mpf, mpmath.mpf]], dps: int) -> list[tuple[mpmath.mpf, mpmath.mpf]]:
-    """``(value, error)`` pairs rounded to ``dps`` digits, each error grown by that rounding.
+def rounded_coefficients(results: list[tuple[mpmath.mpf, mpmath.mpf]], precision: int) -> list[tuple[mpmath.mpf, mpmath.mpf]]:
+    """``(value, error)`` pairs rounded to ``precision`` digits, each error grown by that rounding.
 
-    Call it at the working precision: rounding the result to dps digits adds up
+    Call it at the working precision: rounding the result to precision digits adds up
     to one unit in the last digit.
     """
-    results = [(value, error + abs(value) * mpmath.mpf(10) ** (-dps)) for value, error in results]
-    with mpmath.workdps(dps):
+    results = [(value, error + abs(value) * mpmath.mpf(10) ** (-precision)) for value, error in results]
+    with mpmath.workdps(precision):
         return [(+value, +error) for value, error in results]
 
 
@@ -329,16 +329,16 @@ def _period(
     epsilon: Any,
     a0: Any,
     omega0: Any,
-    dps: int,
+    precision: int,
 ) -> tuple[mpmath.mpf, mpmath.mpf]:
-    """Period and error at ``dps`` digits (computed with guard digits)."""
-    with mpmath.workdps(dps + 20):
+    """Period and error at ``precision`` digits (computed with guard digits)."""
+    with mpmath.workdps(precision + 20):
         epsilon_value = real_parameter(epsilon, "epsilon")
         a0_value = real_parameter(a0, "a0")
         omega0_value = omega0_parameter(omega0)
-        period, difference = _period_by_trapezoid(potential, epsilon_value, a0_value, omega0_value, dps + 5)
-        error = difference + abs(period) * mpmath.mpf(10) ** (-dps)
-    with mpmath.workdps(dps):
+        period, difference = _period_by_trapezoid(potential, epsilon_value, a0_value, omega0_value, precision + 5)
+        error = difference + abs(period) * mpmath.mpf(10) ** (-precision)
+    with mpmath.workdps(precision):
         return +period, +error
 
 
@@ -348,7 +348,7 @@ def conservative_period(
     *,
     a0: Any,
     omega0: Any = 1,
-    dps: int = 30,
+    precision: int = 30,
 ) -> tuple[mpmath.mpf, mpmath.mpf]:
     """Exact period of ``u'' + omega0**2 u + epsilon f(u) = 0``, ``u(0) = a0``, ``u'(0) = 0``.
 
@@ -363,14 +363,14 @@ def conservative_period(
         Release position (the motion starts at rest).
     omega0 : positive real number, optional
         Linear angular frequency.
-    dps : int, optional
+    precision : int, optional
         Decimal digits of the result.
 
     Returns
     -------
     (period, error_estimate) : tuple of mpf
         The error estimate is the last trapezoid refinement difference plus a
-        rounding allowance of one unit in the ``dps``-th digit.
+        rounding allowance of one unit in the ``precision``-th digit.
 
     Raises
     ------
@@ -383,15 +383,15 @@ def conservative_period(
     --------
     >>> import sympy
     >>> u = sympy.Symbol("u")
-    >>> period, error = conservative_period(u**3, 0, a0=1, dps=20)
+    >>> period, error = conservative_period(u**3, 0, a0=1, precision=20)
     >>> mpmath.nstr(period, 20)  # 2 pi
     '6.2831853071795864769'
     >>> error < 1e-18
     True
     """
-    dps = validate_dps(dps)
+    precision = validate_precision(precision)
     potential = _Potential(f)
-    return _period(potential, epsilon, a0, omega0, dps)
+    return _period(potential, epsilon, a0, omega0, precision)
 
 
 def conservative_frequency(
@@ -400,7 +400,7 @@ def conservative_frequency(
     *,
     a0: Any,
     omega0: Any = 1,
-    dps: int = 30,
+    precision: int = 30,
 ) -> tuple[mpmath.mpf, mpmath.mpf]:
     """Exact angular frequency ``2 pi / T`` and its error estimate.
 
@@ -410,17 +410,17 @@ def conservative_frequency(
     --------
     >>> import sympy
     >>> u = sympy.Symbol("u")
-    >>> frequency, error = conservative_frequency(u, 3, a0=1, omega0=1, dps=20)
+    >>> frequency, error = conservative_frequency(u, 3, a0=1, omega0=1, precision=20)
     >>> mpmath.nstr(frequency, 20)  # f = u: linear with omega**2 = 1 + 3
     '2.0'
     """
-    dps = validate_dps(dps)
+    precision = validate_precision(precision)
     potential = _Potential(f)
-    with mpmath.workdps(dps + 10):
-        period, period_error = _period(potential, epsilon, a0, omega0, dps + 10)
+    with mpmath.workdps(precision + 10):
+        period, period_error = _period(potential, epsilon, a0, omega0, precision + 10)
         frequency = 2 * mpmath.pi / period
-        error = frequency * period_error / period + abs(frequency) * mpmath.mpf(10) ** (-dps)
-    with mpmath.workdps(dps):
+        error = frequency * period_error / period + abs(frequency) * mpmath.mpf(10) ** (-precision)
+    with mpmath.workdps(precision):
         return +frequency, +error
 
 
@@ -477,7 +477,7 @@ def frequency_taylor_coefficients(
     *,
     a0: Any,
     omega0: Any = 1,
-    dps: int = 40,
+    precision: int = 40,
 ) -> list[tuple[mpmath.mpf, mpmath.mpf]]:
     """Taylor coefficients ``omega_k`` of the exact frequency ``omega(epsilon)`` at 0.
 
@@ -488,7 +488,7 @@ def frequency_taylor_coefficients(
     the orbit exists, with 33 and 65 points; the Taylor coefficients of the
     65-point interpolant are returned and the difference between the two
     grids, plus a rounding allowance, is the error estimate.  If that estimate
-    is not below ``10**(-dps/2)`` relative, ``r`` is reduced.
+    is not below ``10**(-precision/2)`` relative, ``r`` is reduced.
 
     Parameters
     ----------
@@ -498,7 +498,7 @@ def frequency_taylor_coefficients(
         Highest Taylor coefficient wanted (0 <= order <= 24).
     a0, omega0 : real numbers
         Release position and linear frequency (omega0 > 0).
-    dps : int, optional
+    precision : int, optional
         Working digits of the frequency samples.
 
     Returns
@@ -510,15 +510,15 @@ def frequency_taylor_coefficients(
     --------
     >>> import sympy
     >>> u = sympy.Symbol("u")
-    >>> coefficients = frequency_taylor_coefficients(u**3, 2, a0=1, dps=30)
+    >>> coefficients = frequency_taylor_coefficients(u**3, 2, a0=1, precision=30)
     >>> [mpmath.nstr(value, 12) for value, error in coefficients]  # 1, 3/8, -21/256
     ['1.0', '0.375', '-0.08203125']
     """
     order = validate_order(order, maximum=_MAXIMUM_CHEBYSHEV_ORDER)
-    dps = validate_dps(dps)
+    precision = validate_precision(precision)
     potential = _Potential(f)
     fine_nodes = 64  # the coarse grid is every other node (33 points)
-    working_dps = dps + 15
+    working_dps = precision + 15
     with mpmath.workdps(working_dps):
         a0_value = real_parameter(a0, "a0")
         omega0_value = omega0_parameter(omega0)
@@ -544,10 +544,10 @@ def frequency_taylor_coefficients(
                 rounding = magnitude * mpmath.mpf(10) ** (-working_dps + 3) * fine_nodes**2 / radius**power
                 error = abs(fine[power] - coarse[power]) + rounding
                 results.append((fine[power], error))
-                if error > mpmath.mpf(10) ** (-(dps // 2)) * max(magnitude / radius**power, abs(fine[power])):
+                if error > mpmath.mpf(10) ** (-(precision // 2)) * max(magnitude / radius**power, abs(fine[power])):
                     acceptable = False
             if acceptable:
-                return rounded_coefficients(results, dps)
+                return rounded_coefficients(results, precision)
             last_problem = "Chebyshev grids of 33 and 65 points disagree (the interval reaches a singularity)"
             radius /= 4
     raise ConvergenceError(

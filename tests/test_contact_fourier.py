@@ -292,8 +292,8 @@ def test_mp_path_matches_symbolic_at_fifty_digits(k: int) -> None:
         with mpmath.workdps(60):
             ramp = mpmath.mpf(sympy.N(contact_ramp_coefficient(k, kappa), 70))
             step = mpmath.mpf(sympy.N(contact_step_coefficient(k, kappa), 70))
-            got_ramp = contact_ramp_coefficient_mp(k, kappa, dps=50)
-            got_step = contact_step_coefficient_mp(k, Fraction(kappa.p, kappa.q), dps=50)
+            got_ramp = contact_ramp_coefficient_mp(k, kappa, precision=50)
+            got_step = contact_step_coefficient_mp(k, Fraction(kappa.p, kappa.q), precision=50)
             assert abs(got_ramp - ramp) <= mpmath.mpf(10) ** -49 * abs(ramp)
             assert abs(got_step - step) <= mpmath.mpf(10) ** -49 * abs(step)
 
@@ -301,7 +301,7 @@ def test_mp_path_matches_symbolic_at_fifty_digits(k: int) -> None:
 def test_mp_path_near_grazing_with_exact_rational() -> None:
     kappa = Fraction(1) - Fraction(1, 10**30)
     for k in (0, 1, 2, 7, 10**6):
-        got = contact_ramp_coefficient_mp(k, kappa, dps=40)
+        got = contact_ramp_coefficient_mp(k, kappa, precision=40)
         with mpmath.workdps(300):
             exact_kappa = mpmath.mpf(kappa.numerator) / kappa.denominator
             angle = mpmath.acos(exact_kappa)
@@ -315,29 +315,29 @@ def test_mp_path_near_grazing_with_exact_rational() -> None:
                     - 2 * exact_kappa * mpmath.sin(k * angle) / k
                 ) / mpmath.pi
             assert abs(got - expected) <= mpmath.mpf(10) ** -39 * abs(expected), k
-    negative = contact_ramp_coefficient_mp(3, -kappa, dps=40)
-    assert abs(negative + contact_ramp_coefficient_mp(3, kappa, dps=40)) <= mpmath.mpf(10) ** -39 * abs(negative)
+    negative = contact_ramp_coefficient_mp(3, -kappa, precision=40)
+    assert abs(negative + contact_ramp_coefficient_mp(3, kappa, precision=40)) <= mpmath.mpf(10) ** -39 * abs(negative)
 
 
 def test_mp_path_float_input_uses_exact_binary_value() -> None:
-    got = contact_ramp_coefficient_mp(4, GRAZING, dps=30)
+    got = contact_ramp_coefficient_mp(4, GRAZING, precision=30)
     expected = reference_ramp(4, GRAZING, digits=150)
     with mpmath.workdps(40):
         assert abs(got - expected) <= mpmath.mpf(10) ** -29 * abs(expected)
 
 
 def test_mp_path_outside_unit_interval_and_bad_input() -> None:
-    assert contact_ramp_coefficient_mp(0, 1, dps=20) == 0
-    assert contact_ramp_coefficient_mp(0, -2, dps=20) == 2
-    assert contact_ramp_coefficient_mp(1, "-1", dps=20) == 1
-    assert contact_step_coefficient_mp(0, -1.5, dps=20) == 1
-    assert contact_step_coefficient_mp(3, 4, dps=20) == 0
+    assert contact_ramp_coefficient_mp(0, 1, precision=20) == 0
+    assert contact_ramp_coefficient_mp(0, -2, precision=20) == 2
+    assert contact_ramp_coefficient_mp(1, "-1", precision=20) == 1
+    assert contact_step_coefficient_mp(0, -1.5, precision=20) == 1
+    assert contact_step_coefficient_mp(3, 4, precision=20) == 0
     with pytest.raises(ProblemError):
-        contact_ramp_coefficient_mp(1, "nan", dps=20)
+        contact_ramp_coefficient_mp(1, "nan", precision=20)
     with pytest.raises(ProblemError):
-        contact_ramp_coefficient_mp(1, 0.5, dps=0)
+        contact_ramp_coefficient_mp(1, 0.5, precision=0)
     with pytest.raises(ProblemError):
-        contact_ramp_coefficient_mp(1, KAPPA, dps=20)
+        contact_ramp_coefficient_mp(1, KAPPA, precision=20)
 
 
 # ---------------------------------------------------------------------------
@@ -369,7 +369,7 @@ def test_series_sum_of_squared_odd_denominators_matches_sympy_summation() -> Non
     exact = (squares + telescoping) / 4
     assert sympy.simplify(sympy.apart(1 / (4 * k**2 - 1) ** 2, k) - (
         1 / (2 * k - 1) ** 2 + 1 / (2 * k + 1) ** 2 + 1 / (2 * k + 1) - 1 / (2 * k - 1)) / 4) == 0
-    estimate = series_sum(lambda n: mpmath.mpf(1) / (4 * n * n - 1) ** 2, start=1, dps=30)
+    estimate = series_sum(lambda n: mpmath.mpf(1) / (4 * n * n - 1) ** 2, start=1, precision=30)
     assert isinstance(estimate, SeriesEstimate)
     value, error = estimate
     with mpmath.workdps(40):
@@ -380,7 +380,7 @@ def test_series_sum_of_squared_odd_denominators_matches_sympy_summation() -> Non
 
 
 def test_series_sum_of_inverse_cubes_matches_zeta() -> None:
-    value, error = series_sum(lambda n: mpmath.mpf(1) / n**3, start=1, dps=25)
+    value, error = series_sum(lambda n: mpmath.mpf(1) / n**3, start=1, precision=25)
     with mpmath.workdps(30):
         assert abs(value - mpmath.zeta(3)) <= max(error, mpmath.mpf(10) ** -24)
         assert abs(value - mpmath.zeta(3)) <= mpmath.mpf(10) ** -20
@@ -396,7 +396,7 @@ def test_cosine_series_of_ramp_coefficients_reproduces_the_ramp(kappa: str, poin
         point_mp = mpmath.mpf(point)
         coefficient = _closed_form_ramp_mp(kappa_mp)
         expected = max(mpmath.cos(point_mp) - kappa_mp, 0)
-    estimate = sum_cosine_series_at(coefficient, point_mp, dps=20)
+    estimate = sum_cosine_series_at(coefficient, point_mp, precision=20)
     with mpmath.workdps(40):
         actual_error = abs(estimate.value - expected)
         assert actual_error <= max(estimate.error_estimate, mpmath.mpf(10) ** -19)
@@ -413,7 +413,7 @@ def test_cosine_series_of_absolute_cosine_with_vanishing_odd_terms() -> None:
         k = n // 2
         return -4 * (-1) ** k / (mpmath.pi * (4 * k * k - 1))
 
-    estimate = sum_cosine_series_at(coefficient, "0.3", dps=20)
+    estimate = sum_cosine_series_at(coefficient, "0.3", precision=20)
     with mpmath.workdps(30):
         assert abs(estimate.value - abs(mpmath.cos(mpmath.mpf("0.3")))) <= mpmath.mpf(10) ** -15
 
@@ -422,7 +422,7 @@ def test_exact_period_three_pattern_needs_blocks() -> None:
     kappa = mpmath.mpf(-0.5)  # beta = 2 pi / 3: c_k cos(0) has an exact period-3 pattern
     with mpmath.workdps(40):
         coefficient = _closed_form_ramp_mp(kappa)
-    value, error = sum_cosine_series_at(coefficient, 0, dps=20, block_size=3)
+    value, error = sum_cosine_series_at(coefficient, 0, precision=20, block_size=3)
     with mpmath.workdps(30):
         assert abs(value - mpmath.mpf("1.5")) <= max(error, mpmath.mpf(10) ** -19)
         assert abs(value - mpmath.mpf("1.5")) <= mpmath.mpf(10) ** -15
@@ -435,17 +435,17 @@ def test_kink_point_is_reported_as_not_converged() -> None:
         coefficient = _closed_form_ramp_mp(kappa)
         kink = mpmath.acos(kappa)
     with pytest.raises(ConvergenceError, match="did not converge"):
-        sum_cosine_series_at(coefficient, kink, dps=20, max_terms=300)
+        sum_cosine_series_at(coefficient, kink, precision=20, max_terms=300)
 
 
 def test_divergent_series_raises_convergence_error() -> None:
     with pytest.raises(ConvergenceError):
-        series_sum(lambda n: mpmath.mpf((-1) ** (n // 7)) * n, start=1, dps=10, max_terms=200)
+        series_sum(lambda n: mpmath.mpf((-1) ** (n // 7)) * n, start=1, precision=10, max_terms=200)
 
 
 @pytest.mark.parametrize(
     "kwargs",
-    [{"dps": 3}, {"methods": ("euler",)}, {"methods": ()}, {"block_size": 0}, {"start": -1}, {"max_terms": 10}],
+    [{"precision": 3}, {"methods": ("euler",)}, {"methods": ()}, {"block_size": 0}, {"start": -1}, {"max_terms": 10}],
 )
 def test_series_sum_rejects_bad_options(kwargs: dict) -> None:
     with pytest.raises(ProblemError):
@@ -455,14 +455,14 @@ def test_series_sum_rejects_bad_options(kwargs: dict) -> None:
 def test_finite_cosine_series_terminates() -> None:
     # cos(s)^2 = 1/2 + cos(2 s)/2: all further coefficients vanish identically
     coefficients = {0: mpmath.mpf(1) / 2, 2: mpmath.mpf(1) / 2}
-    value, error = sum_cosine_series_at(lambda k: coefficients.get(k, 0), "0.3", dps=20)
+    value, error = sum_cosine_series_at(lambda k: coefficients.get(k, 0), "0.3", precision=20)
     with mpmath.workdps(30):
         assert abs(value - mpmath.cos(mpmath.mpf("0.3")) ** 2) <= mpmath.mpf(10) ** -19
         assert error <= mpmath.mpf(10) ** -15
 
 
 def test_geometric_series() -> None:
-    value, error = series_sum(lambda k: mpmath.mpf(-2) ** -k, dps=25)
+    value, error = series_sum(lambda k: mpmath.mpf(-2) ** -k, precision=25)
     with mpmath.workdps(30):
         assert abs(value - mpmath.mpf(2) / 3) <= max(error, mpmath.mpf(10) ** -24)
         assert abs(value - mpmath.mpf(2) / 3) <= mpmath.mpf(10) ** -22
@@ -484,7 +484,7 @@ def test_error_estimate_bounds_the_error_when_max_terms_is_reached(theta: int, m
     def term(k: int) -> mpmath.mpf:
         return (1 + mpmath.cos(k * theta)) / mpmath.mpf(k) ** 4
 
-    estimate = series_sum(term, start=1, dps=20, max_terms=max_terms, tolerance=1e-6)
+    estimate = series_sum(term, start=1, precision=20, max_terms=max_terms, tolerance=1e-6)
     assert estimate.method.endswith("max_terms reached")
     with mpmath.workdps(50):
         actual_error = abs(estimate.value - exact)
@@ -495,9 +495,9 @@ def test_vanishing_odd_terms_do_not_stop_the_summation() -> None:
     # kappa = 0: c_k vanishes for odd k >= 3, so the 10th term is 0; summing stops there
     # unless vanishing terms are skipped (a 10-term partial sum is off by 4e-4).
     def coefficient(k: int) -> mpmath.mpf:
-        return contact_ramp_coefficient_mp(k, 0, dps=40)
+        return contact_ramp_coefficient_mp(k, 0, precision=40)
 
-    estimate = sum_cosine_series_at(coefficient, "0.5", dps=20)
+    estimate = sum_cosine_series_at(coefficient, "0.5", precision=20)
     with mpmath.workdps(40):
         actual_error = abs(estimate.value - mpmath.cos(mpmath.mpf("0.5")))
     assert estimate.terms_used > 100
@@ -513,7 +513,7 @@ def test_working_precision_is_set_inside_and_does_not_leak() -> None:
         return mpmath.mpf(1) / k**2
 
     before = mpmath.mp.dps
-    value, error = series_sum(term, start=1, dps=40)
+    value, error = series_sum(term, start=1, precision=40)
     assert mpmath.mp.dps == before
     assert min(seen) >= 40
     with mpmath.workdps(60):

@@ -198,7 +198,7 @@ def test_piecewise_cases_equal_the_exact_period_taylor_coefficients(results, nam
     data = results[name].json
     order = SMALL_ORDER[name]
     with mpmath.workdps(40):
-        reference = piecewise_linear_frequency_taylor(order, a=1, b=mpmath.mpf(sympy.Rational(b).p) / sympy.Rational(b).q, a0=a0, dps=40)
+        reference = piecewise_linear_frequency_taylor(order, a=1, b=mpmath.mpf(sympy.Rational(b).p) / sympy.Rational(b).q, a0=a0, precision=40)
         for k, text in enumerate(data["omega"][label]):
             value = mpmath.mpf(str(sympy.N(parse(text), 40)))
             assert abs(value - reference[k][0]) <= PIECEWISE_TOLERANCE, (name, k)
@@ -220,7 +220,7 @@ def test_gap_closed_forms_in_kappa_against_independent_references(results):
     # any |κ| < 1, both signs: the exact period (ω0 = 1)
     for kappa in (sympy.Rational(1, 3), sympy.Rational(-1, 2), sympy.Rational(7, 10)):
         with mpmath.workdps(40):
-            reference = piecewise_linear_frequency_taylor(2, a=1, b=mpmath.mpf(kappa.p) / kappa.q, a0=1, dps=40)
+            reference = piecewise_linear_frequency_taylor(2, a=1, b=mpmath.mpf(kappa.p) / kappa.q, a0=1, precision=40)
             for k, form in ((1, omega1), (2, omega2)):
                 value = mpmath.mpf(str(sympy.N(at(form, kappa).subs(OMEGA0, 1), 40)))
                 assert abs(value - reference[k][0]) <= PIECEWISE_TOLERANCE, (kappa, k)

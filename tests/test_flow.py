@@ -332,10 +332,10 @@ def test_simultaneous_switches_of_symmetric_springs():
     np.testing.assert_allclose(switches[2::2] - switches[1:-1:2], duration, rtol=1e-12)
 
 
-def free_flight_reference(M, K, x0, v0, t, dps=40):
+def free_flight_reference(M, K, x0, v0, t, precision=40):
     """X(t) of M X'' + K X = 0 in mpmath: y = Lᵀ X (M = L Lᵀ) obeys y'' + L⁻¹ K L⁻ᵀ y = 0, solved by eigsy."""
     n = len(x0)
-    with mpmath.workdps(dps):
+    with mpmath.workdps(precision):
         lower = mpmath.cholesky(mpmath.matrix(np.asarray(M).tolist()))
         inverse = mpmath.inverse(lower)
         symmetric = inverse * mpmath.matrix(np.asarray(K).tolist()) * inverse.T

@@ -49,7 +49,7 @@ def test_float_mode_matches_exact_period_taylor_coefficients(kappa, release):
             return mpmath.mpf(value.p) / value.q
 
         reference = piecewise_linear_frequency_taylor(
-            4, a=exact(stiffness), b=exact(gap), a0=exact(sympy.Rational(release)), omega0=exact(linear_frequency), dps=40
+            4, a=exact(stiffness), b=exact(gap), a0=exact(sympy.Rational(release)), omega0=exact(linear_frequency), precision=40
         )
         for k in range(1, 5):
             value, error = reference[k]
@@ -61,7 +61,7 @@ def test_float_mode_matches_exact_period_taylor_coefficients(kappa, release):
 def test_exact_mode_agrees_to_30_digits(kappa):
     expansion = lindstedt.expand(f"Max(0, u - ({kappa}))", order=3, a0=1, omega0=1)
     with mpmath.workdps(50):
-        reference = piecewise_linear_frequency_taylor(3, a=1, b=mpmath.mpf(sympy.Rational(kappa)), a0=1, dps=50)
+        reference = piecewise_linear_frequency_taylor(3, a=1, b=mpmath.mpf(sympy.Rational(kappa)), a0=1, precision=50)
         for k in range(1, 4):
             value, error = reference[k]
             ours = mpmath.mpf(sympy.N(expansion.omega[k], 45))
@@ -72,7 +72,7 @@ def test_high_precision_mode_keeps_30_digits_near_grazing():
     kappa = sympy.Rational(999, 1000)
     expansion = lindstedt.expand("Max(0, u - 999/1000)", order=4, a0=1, omega0=1, numeric=True, precision=50)
     with mpmath.workdps(60):
-        reference = piecewise_linear_frequency_taylor(4, a=1, b=mpmath.mpf(kappa), a0=1, dps=60)
+        reference = piecewise_linear_frequency_taylor(4, a=1, b=mpmath.mpf(kappa), a0=1, precision=60)
         for k in range(1, 5):
             value, error = reference[k]
             assert abs(mpmath.mpf(sympy.N(expansion.omega[k], 50)) - value) <= max(mpmath.mpf(10) ** -30 * abs(value), 10 * error)
@@ -217,7 +217,7 @@ def test_float_path_keeps_12_digits_next_to_grazing(kappa):
     exact_kappa = sympy.sympify(kappa)
     expansion = lindstedt.expand(f"Max(0, u - ({exact_kappa}))", order=2, a0=1, omega0=1, numeric=True, precision=16)
     with mpmath.workdps(80):
-        reference = piecewise_linear_frequency_taylor(2, a=1, b=mpmath.mpf(exact_kappa.p) / exact_kappa.q, a0=1, dps=80)
+        reference = piecewise_linear_frequency_taylor(2, a=1, b=mpmath.mpf(exact_kappa.p) / exact_kappa.q, a0=1, precision=80)
         for k in (1, 2):
             value, error = reference[k]
             assert error < 1e-40 * abs(value)

@@ -158,7 +158,7 @@ def test_taylor_polynomial_error_has_slope_order_plus_one(order, normalization, 
                 omega0=omega0,
                 coefficient=coefficient,
                 normalization=normalization,
-                dps=50,
+                precision=50,
             )
             polynomial = omega0 * mpmath.fsum(
                 mpmath.mpf(int(r.p)) / int(r.q) * x**power for power, r in enumerate(rationals)
@@ -211,8 +211,8 @@ def test_epsilon_and_coefficient_enter_as_a_product():
 @pytest.mark.parametrize("epsilon", ["0.37", "-0.45"])
 def test_higher_precision_agrees_and_does_not_leak(normalization, epsilon):
     global_dps = mpmath.mp.dps
-    low = duffing_exact_frequency(epsilon, amplitude="0.9", omega0="1.1", normalization=normalization, dps=30)
-    high = duffing_exact_frequency(epsilon, amplitude="0.9", omega0="1.1", normalization=normalization, dps=50)
+    low = duffing_exact_frequency(epsilon, amplitude="0.9", omega0="1.1", normalization=normalization, precision=30)
+    high = duffing_exact_frequency(epsilon, amplitude="0.9", omega0="1.1", normalization=normalization, precision=50)
     assert mpmath.mp.dps == global_dps
     with mpmath.workdps(60):
         assert abs(high - low) <= mpmath.mpf(10) ** -28 * abs(high)
@@ -222,8 +222,8 @@ def test_higher_precision_agrees_and_does_not_leak(normalization, epsilon):
 @pytest.mark.parametrize("harmonic_amplitude", ["1.27", "1.2732"])
 def test_softening_harmonic_amplitude_close_to_square_wave_limit(harmonic_amplitude):
     # Supremum 4/pi = 1.27324: the turning point is within ~1e-18 (resp. ~1e-70) of the hilltop.
-    low = duffing_exact_frequency(-1, amplitude=harmonic_amplitude, normalization="harmonic", dps=30)
-    high = duffing_exact_frequency(-1, amplitude=harmonic_amplitude, normalization="harmonic", dps=50)
+    low = duffing_exact_frequency(-1, amplitude=harmonic_amplitude, normalization="harmonic", precision=30)
+    high = duffing_exact_frequency(-1, amplitude=harmonic_amplitude, normalization="harmonic", precision=50)
     with mpmath.workdps(60):
         assert abs(high - low) <= mpmath.mpf(10) ** -28 * high
     near_limit = duffing_exact_frequency(-1, amplitude="1.2", normalization="harmonic")
@@ -233,8 +233,8 @@ def test_softening_harmonic_amplitude_close_to_square_wave_limit(harmonic_amplit
 def test_initial_amplitude_extremely_close_to_separatrix_keeps_precision():
     with mpmath.workdps(80):
         epsilon = -(1 - mpmath.mpf(10) ** -40)
-        low = duffing_exact_frequency(epsilon, amplitude=1, dps=30)
-        high = duffing_exact_frequency(epsilon, amplitude=1, dps=50)
+        low = duffing_exact_frequency(epsilon, amplitude=1, precision=30)
+        high = duffing_exact_frequency(epsilon, amplitude=1, precision=50)
         assert abs(high - low) <= mpmath.mpf(10) ** -28 * high
 
 
@@ -243,7 +243,7 @@ def test_softening_close_to_separatrix_still_periodic():
     # m -> -infinity asymptotics K(m) ~ log(4 sqrt(-m))/sqrt(-m) to leading order.
     with mpmath.workdps(40):
         x = -(1 - mpmath.mpf(10) ** -8)
-        frequency = duffing_exact_frequency(x, amplitude=1, dps=30)
+        frequency = duffing_exact_frequency(x, amplitude=1, precision=30)
         parameter = x / (2 * (1 + x))
         asymptotic_period = 4 * mpmath.log(4 * mpmath.sqrt(-parameter)) / mpmath.sqrt(-parameter) / mpmath.sqrt(1 + x)
         assert abs(2 * mpmath.pi / frequency / asymptotic_period - 1) < 1e-6

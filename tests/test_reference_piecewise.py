@@ -106,7 +106,7 @@ def test_symbolic_series_matches_numerical_cauchy_coefficients():
     series = piecewise_linear_frequency_taylor_symbolic(order, epsilon=epsilon, a=a, omega0=omega0)
     numeric_a, numeric_omega0 = sympy.Rational(17, 10), sympy.Rational(11, 10)
     polynomial = sympy.Poly(series.subs({a: numeric_a, omega0: numeric_omega0}), epsilon)
-    coefficients = piecewise_linear_frequency_taylor(order, a=numeric_a, b=0, a0="-0.8", omega0=numeric_omega0, dps=40)
+    coefficients = piecewise_linear_frequency_taylor(order, a=numeric_a, b=0, a0="-0.8", omega0=numeric_omega0, precision=40)
     with mpmath.workdps(50):
         for power, (value, error) in enumerate(coefficients):
             exact = polynomial.coeff_monomial(epsilon**power)
@@ -197,7 +197,7 @@ def grazing_scale(kappa: float, a0_sign: int) -> float:
 def test_taylor_polynomial_error_has_slope_order_plus_one(kappa, a0_sign):
     a, omega0, magnitude = mpmath.mpf("1.3"), mpmath.mpf("0.9"), mpmath.mpf("0.8")
     a0, b = a0_sign * magnitude, kappa * magnitude
-    coefficients = piecewise_linear_frequency_taylor(5, a=a, b=b, a0=a0, omega0=omega0, dps=40)
+    coefficients = piecewise_linear_frequency_taylor(5, a=a, b=b, a0=a0, omega0=omega0, precision=40)
     scale = grazing_scale(kappa, a0_sign) * omega0**2 / a
     with mpmath.workdps(40):
         for order in range(0, 6):
@@ -205,7 +205,7 @@ def test_taylor_polynomial_error_has_slope_order_plus_one(kappa, a0_sign):
                 epsilons, errors = [], []
                 for fraction in ("0.005", "0.01", "0.02"):
                     epsilon = sign * scale * mpmath.mpf(fraction)
-                    exact = piecewise_linear_exact_frequency(epsilon, a=a, b=b, a0=a0, omega0=omega0, dps=40)
+                    exact = piecewise_linear_exact_frequency(epsilon, a=a, b=b, a0=a0, omega0=omega0, precision=40)
                     polynomial = mpmath.fsum(value * epsilon**power for power, (value, _) in enumerate(coefficients[: order + 1]))
                     epsilons.append(epsilon)
                     errors.append(exact - polynomial)
@@ -233,10 +233,10 @@ def test_grazing_taylor_raises_problem_error():
 @pytest.mark.parametrize("kappa", [-0.3, 0.5])
 def test_higher_precision_agrees_and_does_not_leak(kappa):
     global_dps = mpmath.mp.dps
-    low = piecewise_linear_exact_frequency("0.37", a="1.3", b=kappa, a0=1, omega0="0.9", dps=30)
-    high = piecewise_linear_exact_frequency("0.37", a="1.3", b=kappa, a0=1, omega0="0.9", dps=50)
-    low_taylor = piecewise_linear_frequency_taylor(3, a="1.3", b=kappa, a0=-1, omega0="0.9", dps=30)
-    high_taylor = piecewise_linear_frequency_taylor(3, a="1.3", b=kappa, a0=-1, omega0="0.9", dps=50)
+    low = piecewise_linear_exact_frequency("0.37", a="1.3", b=kappa, a0=1, omega0="0.9", precision=30)
+    high = piecewise_linear_exact_frequency("0.37", a="1.3", b=kappa, a0=1, omega0="0.9", precision=50)
+    low_taylor = piecewise_linear_frequency_taylor(3, a="1.3", b=kappa, a0=-1, omega0="0.9", precision=30)
+    high_taylor = piecewise_linear_frequency_taylor(3, a="1.3", b=kappa, a0=-1, omega0="0.9", precision=50)
     assert mpmath.mp.dps == global_dps
     with mpmath.workdps(60):
         assert abs(high - low) <= mpmath.mpf(10) ** -28 * high
@@ -265,8 +265,8 @@ def test_frequency_depends_on_b_and_a0_only_through_kappa_and_sign(
     # at 50 digits (near grazing, |kappa| -> 1, the arccos terms amplify rounding far beyond 1e-30), plus
     # the final rounding to 30 digits.
     def reference(*arguments, **keywords):
-        low = piecewise_linear_exact_frequency(*arguments, dps=30, **keywords)
-        high = piecewise_linear_exact_frequency(*arguments, dps=50, **keywords)
+        low = piecewise_linear_exact_frequency(*arguments, precision=30, **keywords)
+        high = piecewise_linear_exact_frequency(*arguments, precision=50, **keywords)
         with mpmath.workdps(60):
             return low, abs(high - low) + mpmath.mpf(10) ** -30 * abs(low)
 

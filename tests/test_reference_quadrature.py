@@ -60,7 +60,7 @@ def duffing_period_closed_form(epsilon, a0, omega0, coefficient=1):
 def test_linear_nonlinearity_gives_shifted_frequency(epsilon):
     # f = 2u: omega**2 = omega0**2 + 2 epsilon exactly.
     with mpmath.workdps(40):
-        frequency, error = conservative_frequency(2 * U, epsilon, a0="0.6", omega0="1.5", dps=30)
+        frequency, error = conservative_frequency(2 * U, epsilon, a0="0.6", omega0="1.5", precision=30)
         exact = mpmath.sqrt(mpmath.mpf("1.5") ** 2 + 2 * mpmath.mpf(epsilon))
         assert abs(frequency - exact) <= mpmath.mpf(10) ** -28 * exact
         assert error < mpmath.mpf(10) ** -27
@@ -69,7 +69,7 @@ def test_linear_nonlinearity_gives_shifted_frequency(epsilon):
 @pytest.mark.parametrize("epsilon, a0, omega0", [("0.5", "1", "1"), ("-0.9", "0.7", "1.3"), ("4", "-1.2", "0.8")])
 def test_duffing_period_matches_elliptic_integral(epsilon, a0, omega0):
     with mpmath.workdps(40):
-        period, error = conservative_period(U**3, epsilon, a0=a0, omega0=omega0, dps=30)
+        period, error = conservative_period(U**3, epsilon, a0=a0, omega0=omega0, precision=30)
         exact = duffing_period_closed_form(mpmath.mpf(epsilon), mpmath.mpf(a0), mpmath.mpf(omega0))
         assert abs(period - exact) <= error
         assert abs(period - exact) <= mpmath.mpf(10) ** -28 * exact
@@ -78,7 +78,7 @@ def test_duffing_period_matches_elliptic_integral(epsilon, a0, omega0):
 @pytest.mark.parametrize("epsilon", [-0.4, 0.15, 0.45])
 @pytest.mark.parametrize("a0", [0.7, -0.9])
 def test_quadratic_period_matches_integration(epsilon, a0):
-    period, error = conservative_period(U**2, epsilon, a0=a0, omega0=1.2, dps=20)
+    period, error = conservative_period(U**2, epsilon, a0=a0, omega0=1.2, precision=20)
     numerical = integrated_period(lambda value: value**2, epsilon, a0, 1.2)
     assert float(period) == pytest.approx(numerical, rel=1e-11, abs=0)
     assert error < 1e-18
@@ -86,16 +86,16 @@ def test_quadratic_period_matches_integration(epsilon, a0):
 
 @pytest.mark.parametrize("epsilon", [-0.6, 0.3, 1.5])
 def test_sine_period_matches_integration(epsilon):
-    period, _ = conservative_period(sympy.sin(U), epsilon, a0=1.1, omega0=0.9, dps=20)
+    period, _ = conservative_period(sympy.sin(U), epsilon, a0=1.1, omega0=0.9, precision=20)
     numerical = integrated_period(np.sin, epsilon, 1.1, 0.9)
     assert float(period) == pytest.approx(numerical, rel=1e-11, abs=0)
 
 
 def test_callable_nonlinearity_matches_expression():
     with mpmath.workdps(30):
-        from_expression, _ = conservative_period(sympy.sin(U) + U**2, "-0.3", a0="0.7", dps=25)
+        from_expression, _ = conservative_period(sympy.sin(U) + U**2, "-0.3", a0="0.7", precision=25)
         from_callable, error = conservative_period(
-            lambda value: mpmath.sin(value) + value**2, "-0.3", a0="0.7", dps=25
+            lambda value: mpmath.sin(value) + value**2, "-0.3", a0="0.7", precision=25
         )
         assert abs(from_expression - from_callable) <= mpmath.mpf(10) ** -23
         assert error < mpmath.mpf(10) ** -23
@@ -103,8 +103,8 @@ def test_callable_nonlinearity_matches_expression():
 
 def test_precision_does_not_leak_and_converges():
     global_dps = mpmath.mp.dps
-    low, _ = conservative_period(U**2 + U**3, "0.4", a0="0.8", dps=20)
-    high, _ = conservative_period(U**2 + U**3, "0.4", a0="0.8", dps=40)
+    low, _ = conservative_period(U**2 + U**3, "0.4", a0="0.8", precision=20)
+    high, _ = conservative_period(U**2 + U**3, "0.4", a0="0.8", precision=40)
     assert mpmath.mp.dps == global_dps
     with mpmath.workdps(50):
         assert abs(high - low) <= mpmath.mpf(10) ** -19 * high
@@ -122,8 +122,8 @@ def test_cubic_scaling_law(a0, omega0, strength):
     with mpmath.workdps(30):
         epsilon = mpmath.mpf(strength) * mpmath.mpf(omega0) ** 2 / mpmath.mpf(a0) ** 2
         scaled_epsilon = epsilon * mpmath.mpf(a0) ** 2 / mpmath.mpf(omega0) ** 2
-        original, error_original = conservative_frequency(U**3, epsilon, a0=a0, omega0=omega0, dps=20)
-        reduced, error_reduced = conservative_frequency(U**3, scaled_epsilon, a0=1, omega0=1, dps=20)
+        original, error_original = conservative_frequency(U**3, epsilon, a0=a0, omega0=omega0, precision=20)
+        reduced, error_reduced = conservative_frequency(U**3, scaled_epsilon, a0=1, omega0=1, precision=20)
         difference = abs(original - mpmath.mpf(omega0) * reduced)
         assert difference <= error_original + omega0 * error_reduced + mpmath.mpf(10) ** -18 * original
 
@@ -132,7 +132,7 @@ def test_cubic_scaling_law(a0, omega0, strength):
 def test_duffing_taylor_coefficients_match_exact_rationals():
     a0, omega0 = sympy.Rational(7, 10), sympy.Rational(13, 10)
     order = 8
-    coefficients = frequency_taylor_coefficients(U**3, order, a0=a0, omega0=omega0, dps=40)
+    coefficients = frequency_taylor_coefficients(U**3, order, a0=a0, omega0=omega0, precision=40)
     rationals = duffing_frequency_taylor(order, "initial")
     with mpmath.workdps(50):
         for power, ((value, error), rational) in enumerate(zip(coefficients, rationals)):
@@ -146,7 +146,7 @@ def test_duffing_taylor_coefficients_match_exact_rationals():
 def test_quadratic_first_order_coefficient_vanishes_and_second_is_textbook():
     # f = u**2, omega0 = 1: omega = 1 - (5/12) epsilon**2 a0**2 + O(epsilon**3) (classical second-order
     # result; the first-order shift of a quadratic force vanishes because <cos**3> = 0).
-    coefficients = frequency_taylor_coefficients(U**2, 3, a0="0.6", omega0=1, dps=30)
+    coefficients = frequency_taylor_coefficients(U**2, 3, a0="0.6", omega0=1, precision=30)
     with mpmath.workdps(40):
         assert abs(coefficients[1][0]) <= coefficients[1][1] + mpmath.mpf(10) ** -25
         exact_second = -mpmath.mpf(5) / 12 * mpmath.mpf("0.6") ** 2
@@ -178,4 +178,4 @@ def test_invalid_problems_raise_problem_errors():
     with pytest.raises(ProblemError):
         conservative_period("u**3", "0.1", a0=1)
     with pytest.raises(ProblemError):
-        conservative_period(U**3, "0.1", a0=1, dps=2)
+        conservative_period(U**3, "0.1", a0=1, precision=2)

@@ -25,7 +25,7 @@ def test_omega_k_match_quadrature_taylor_coefficients(text, expression, a0, omeg
     expansion = lindstedt.expand(text, order=ORDER, a0=a0, omega0=omega0, precision=40)
     with mpmath.workdps(40):
         reference = frequency_taylor_coefficients(
-            expression, ORDER, a0=mpmath.mpf(sympy.Rational(a0)), omega0=mpmath.mpf(sympy.Rational(omega0)), dps=40
+            expression, ORDER, a0=mpmath.mpf(sympy.Rational(a0)), omega0=mpmath.mpf(sympy.Rational(omega0)), precision=40
         )
         for k in range(1, ORDER + 1):
             value, error = reference[k]

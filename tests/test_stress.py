@@ -39,7 +39,7 @@ def test_near_grazing_piecewise_float_path_stays_accurate_at_high_order():
     from lindstedt.references import piecewise_linear_frequency_taylor
 
     with mpmath.workdps(60):
-        reference = piecewise_linear_frequency_taylor(4, a=1, b=mpmath.mpf(kappa.p) / kappa.q, a0=1, dps=60)
+        reference = piecewise_linear_frequency_taylor(4, a=1, b=mpmath.mpf(kappa.p) / kappa.q, a0=1, precision=60)
         for k in range(1, 5):
             value, _ = reference[k]
             assert abs(mpmath.mpf(sympy.N(expansion.omega[k], 40)) - value) <= 1e-15 * abs(value)

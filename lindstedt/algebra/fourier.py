@@ -388,11 +388,11 @@ def _exact_kappa_parts(kappa: KappaLike) -> tuple[int, object, object]:
     return sign, magnitude, mpmath.fsub(1, magnitude, exact=True)
 
 
-def _coefficient_mp(k: int, kappa: KappaLike, dps: int, ramp: bool) -> mpmath.mpf:
-    if not isinstance(dps, int) or isinstance(dps, bool) or dps < 1:
-        raise ProblemError(f"dps={dps!r} must be a positive int number of decimal digits")
+def _coefficient_mp(k: int, kappa: KappaLike, precision: int, ramp: bool) -> mpmath.mpf:
+    if not isinstance(precision, int) or isinstance(precision, bool) or precision < 1:
+        raise ProblemError(f"precision={precision!r} must be a positive int number of decimal digits")
     harmonic = _as_harmonic(k)
-    with mpmath.workdps(dps + 10):
+    with mpmath.workdps(precision + 10):
         sign, magnitude, gap = _exact_kappa_parts(kappa)
         if gap <= 0:  # |kappa| >= 1
             if sign > 0:
@@ -403,7 +403,7 @@ def _coefficient_mp(k: int, kappa: KappaLike, dps: int, ramp: bool) -> mpmath.mp
         angle_estimate = 2 * mpmath.asin(mpmath.sqrt(gap / 2))
         phase_estimate = angle_estimate * max(harmonic, 1)
         lost_digits = 0 if phase_estimate >= 1 else int(-2 * mpmath.log10(phase_estimate)) + 1
-    with mpmath.workdps(dps + 15 + lost_digits):
+    with mpmath.workdps(precision + 15 + lost_digits):
         sign, magnitude, gap = _exact_kappa_parts(kappa)
         angle = 2 * mpmath.asin(mpmath.sqrt(gap / 2))
         sine_of_angle = mpmath.sqrt(gap * (1 + magnitude))
@@ -425,12 +425,12 @@ def _coefficient_mp(k: int, kappa: KappaLike, dps: int, ramp: bool) -> mpmath.mp
             value = angle / pi if harmonic == 0 else 2 * mpmath.sin(harmonic * angle) / (pi * harmonic)
             if sign < 0:
                 value = 1 - value if harmonic == 0 else -((-1) ** harmonic) * value
-    with mpmath.workdps(dps):
+    with mpmath.workdps(precision):
         return +value
 
 
-def contact_ramp_coefficient_mp(k: int, kappa: KappaLike, dps: int = 50) -> mpmath.mpf:
-    """``c_k[kappa]`` with mpmath, correct to about ``dps`` significant digits.
+def contact_ramp_coefficient_mp(k: int, kappa: KappaLike, precision: int = 50) -> mpmath.mpf:
+    """``c_k[kappa]`` with mpmath, correct to about ``precision`` significant digits.
 
     Guard digits are added automatically to absorb the cancellation of the closed
     form when ``k * beta`` is small; ``1 - |kappa|`` is formed exactly for int,
@@ -442,27 +442,27 @@ def contact_ramp_coefficient_mp(k: int, kappa: KappaLike, dps: int = 50) -> mpma
         Harmonic index ``k >= 0``.
     kappa : int, float, str, Fraction, mpf or sympy number
         Contact threshold (floats are taken at their exact binary value).
-    dps : int, optional
+    precision : int, optional
         Decimal digits of the result (default 50).
 
     Returns
     -------
     mpmath.mpf
-        The coefficient rounded to ``dps`` digits.
+        The coefficient rounded to ``precision`` digits.
 
     Examples
     --------
     >>> import mpmath
     >>> with mpmath.workdps(30):
-    ...     value = contact_ramp_coefficient_mp(2, 0, dps=30)
+    ...     value = contact_ramp_coefficient_mp(2, 0, precision=30)
     ...     print(mpmath.almosteq(value, 2 / (3 * mpmath.pi), rel_eps=mpmath.mpf(10) ** -29))
     True
     """
-    return _coefficient_mp(k, kappa, dps, ramp=True)
+    return _coefficient_mp(k, kappa, precision, ramp=True)
 
 
-def contact_step_coefficient_mp(k: int, kappa: KappaLike, dps: int = 50) -> mpmath.mpf:
-    """``h_k[kappa]`` with mpmath at ``dps`` digits (see :func:`contact_ramp_coefficient_mp`).
+def contact_step_coefficient_mp(k: int, kappa: KappaLike, precision: int = 50) -> mpmath.mpf:
+    """``h_k[kappa]`` with mpmath at ``precision`` digits (see :func:`contact_ramp_coefficient_mp`).
 
     Parameters
     ----------
@@ -470,7 +470,7 @@ def contact_step_coefficient_mp(k: int, kappa: KappaLike, dps: int = 50) -> mpma
         Harmonic index ``k >= 0``.
     kappa : int, float, str, Fraction, mpf or sympy number
         Contact threshold.
-    dps : int, optional
+    precision : int, optional
         Decimal digits of the result (default 50).
 
     Returns
@@ -480,9 +480,9 @@ def contact_step_coefficient_mp(k: int, kappa: KappaLike, dps: int = 50) -> mpma
 
     Examples
     --------
-    >>> contact_step_coefficient_mp(0, 0, dps=20)
+    >>> contact_step_coefficient_mp(0, 0, precision=20)
     mpf('0.5')
     """
-    return _coefficient_mp(k, kappa, dps, ramp=False)
+    return _coefficient_mp(k, kappa, precision, ramp=False)
 
 

@@ -72,10 +72,10 @@ class SeriesEstimate:
     value : mpmath.mpf
         Accelerated estimate of the sum (``mpmath.nsum``).
     error_estimate : mpmath.mpf
-        Estimated absolute error: the disagreement of ``nsum`` at ``dps`` and at
-        ``dps + 10`` digits when its stopping rule is met, otherwise twice the largest
+        Estimated absolute error: the disagreement of ``nsum`` at ``precision`` and at
+        ``precision + 10`` digits when its stopping rule is met, otherwise twice the largest
         distance of its value to those from 1/2 and 3/4 of ``max_terms``; never below
-        ``10**-dps * max(|value|, 1)``.
+        ``10**-precision * max(|value|, 1)``.
     terms_used : int
         Number of terms evaluated in the run that delivered the value.
     method : str
@@ -163,14 +163,14 @@ class _Blocks:
 def _series_core(
     term: Callable[[int], object],
     start: int,
-    dps: int,
+    precision: int,
     tolerance: object | None,
     max_terms: int,
     block_size: int,
     methods: tuple[str, ...],
 ) -> SeriesEstimate:
-    if not isinstance(dps, int) or isinstance(dps, bool) or dps < 5:
-        raise ProblemError(f"dps={dps!r} must be an int >= 5")
+    if not isinstance(precision, int) or isinstance(precision, bool) or precision < 5:
+        raise ProblemError(f"precision={precision!r} must be an int >= 5")
     start_index = _as_harmonic(start, "start")
     block = _as_harmonic(block_size, "block_size")
     if block < 1:
@@ -187,7 +187,7 @@ def _series_core(
         # nsum at `digits`; when its stopping rule is not met, twice the spread of its
         # values from fewer terms (same cached blocks) is the error estimate
         with mpmath.workdps(digits):
-            blocks = _Blocks(term, start_index, block, mpmath.mpf(10) ** -(dps + 3))
+            blocks = _Blocks(term, start_index, block, mpmath.mpf(10) ** -(precision + 3))
             budget = blocks.budget(maxterms)
             value, converged = blocks.nsum(budget, method)
             spread = mpmath.mpf(0)
@@ -197,15 +197,15 @@ def _series_core(
                     spread = max(spread, _SCATTER_FACTOR * abs(value - shorter))
             return value, converged, spread, blocks
 
-    value, converged, error, blocks = run(dps)
+    value, converged, error, blocks = run(precision)
     if converged:  # confirm with 10 more digits: nsum then has to agree to a 10**10 finer tolerance
         first = value
-        value, converged, spread, blocks = run(dps + _EXTRA_DIGITS)
-        with mpmath.workdps(dps + _EXTRA_DIGITS):
+        value, converged, spread, blocks = run(precision + _EXTRA_DIGITS)
+        with mpmath.workdps(precision + _EXTRA_DIGITS):
             error = max(abs(value - first), spread)
-    with mpmath.workdps(dps):
-        target = mpmath.mpf(10) ** (-(dps // 2)) if tolerance is None else mpmath.mpf(tolerance)
-        error = max(error, mpmath.mpf(10) ** (-dps) * max(abs(value), 1))
+    with mpmath.workdps(precision):
+        target = mpmath.mpf(10) ** (-(precision // 2)) if tolerance is None else mpmath.mpf(tolerance)
+        error = max(error, mpmath.mpf(10) ** (-precision) * max(abs(value), 1))
         if not mpmath.isfinite(error) or error > target:
             raise ConvergenceError(
                 f"series did not converge to tolerance {mpmath.nstr(target, 3)}: best estimate "
@@ -220,7 +220,7 @@ def _series_core(
 def series_sum(
     term_function: Callable[[int], object],
     start: int = 0,
-    dps: int = 30,
+    precision: int = 30,
     *,
     tolerance: object | None = None,
     max_terms: int = 600,
@@ -232,9 +232,9 @@ def series_sum(
     ``mpmath.nsum`` (Richardson and Shanks by default) sums the series; terms that
     vanish (e.g. every odd coefficient of an even function of ``cos(s)``) are skipped.
     The error estimate: when nsum's stopping rule is met, the disagreement with a
-    second nsum at ``dps + 10`` digits; when ``max_terms`` is reached first, twice the
+    second nsum at ``precision + 10`` digits; when ``max_terms`` is reached first, twice the
     largest distance of nsum's value to those from 1/2 and 3/4 of ``max_terms``; never
-    below ``10**-dps * max(|value|, 1)``.
+    below ``10**-precision * max(|value|, 1)``.
 
     Parameters
     ----------
@@ -243,10 +243,10 @@ def series_sum(
         It is evaluated under the working precision set here (``mp.workdps``).
     start : int, optional
         First index (default 0).
-    dps : int, optional
+    precision : int, optional
         Decimal digits of the computation (default 30).
     tolerance : number, optional
-        Absolute tolerance on the error estimate; default ``10**-(dps//2)``.
+        Absolute tolerance on the error estimate; default ``10**-(precision//2)``.
     max_terms : int, optional
         Terms evaluated per nsum run (default 600; nsum completes its last batch of
         terms, up to 10% more).
@@ -270,19 +270,19 @@ def series_sum(
     Examples
     --------
     >>> import mpmath
-    >>> value, error = series_sum(lambda k: mpmath.mpf(1) / k**2, start=1, dps=20)
+    >>> value, error = series_sum(lambda k: mpmath.mpf(1) / k**2, start=1, precision=20)
     >>> with mpmath.workdps(20):
     ...     print(abs(value - mpmath.pi**2 / 6) < 1e-18, error < 1e-9)
     True True
     """
-    return _series_core(term_function, start, dps, tolerance, max_terms, block_size, tuple(methods))
+    return _series_core(term_function, start, precision, tolerance, max_terms, block_size, tuple(methods))
 
 
 def sum_cosine_series_at(
     coefficients_function: Callable[[int], object],
     s: object,
     start: int = 0,
-    dps: int = 30,
+    precision: int = 30,
     *,
     tolerance: object | None = None,
     max_terms: int = 600,
@@ -304,7 +304,7 @@ def sum_cosine_series_at(
         Evaluation point (mpmath, float, str, Fraction or sympy number).
     start : int, optional
         First harmonic (default 0).
-    dps : int, optional
+    precision : int, optional
         Decimal digits (default 30).
     tolerance, max_terms, block_size, methods
         As in :func:`series_sum`.
@@ -323,7 +323,7 @@ def sum_cosine_series_at(
     --------
     >>> import mpmath
     >>> from lindstedt.algebra import contact_ramp_coefficient_mp
-    >>> estimate = sum_cosine_series_at(lambda k: contact_ramp_coefficient_mp(k, 0, 40), 0.5, dps=20)
+    >>> estimate = sum_cosine_series_at(lambda k: contact_ramp_coefficient_mp(k, 0, 40), 0.5, precision=20)
     >>> bool(abs(estimate.value - mpmath.cos(0.5)) < 1e-15)
     True
     """
@@ -331,4 +331,4 @@ def sum_cosine_series_at(
         angle = _to_mpf(s)
         return _to_mpf(coefficients_function(k)) * mpmath.cos(k * angle)
 
-    return _series_core(term, start, dps, tolerance, max_terms, block_size, tuple(methods))
+    return _series_core(term, start, precision, tolerance, max_terms, block_size, tuple(methods))
