@@ -55,7 +55,7 @@ import scipy.optimize
 
 from .._errors import ProblemError
 from .._system import UnilateralSystem
-from .results import ContinuationProgress, NNMBranch, NNMResult, _branch_events, _failed
+from .results import ContinuationProgress, NNMBranch, NNMResult, _branch_events
 from .sensitivity import _check_epsilon, _integrate
 from .shooting import (
     _TWO_PI,
@@ -75,42 +75,46 @@ _PARAMETERS = ("epsilon", "energy", "modal_amplitude")
 # --------------------------------------------------------------------------- #
 # the continuation parameter
 # --------------------------------------------------------------------------- #
+@dataclass(frozen=True)
 class _Path:
     """Map the continuation parameter λ to (ε, amplitude) and back."""
 
-    def __init__(self, parameter: str, amplitude: _Amplitude | None, epsilon: float | None):
-        self.parameter = parameter
-        self.amplitude = amplitude
-        self.epsilon = epsilon
+    parameter: str
+    amplitude: _Amplitude | None  # fixed, when λ = ε
+    epsilon: float | None  # fixed, when λ is the energy or the modal amplitude
 
     def at(self, value: float) -> tuple[float, _Amplitude]:
         if self.parameter == "epsilon":
             return value, self.amplitude
-        kind = "energy" if self.parameter == "energy" else "modal_amplitude"
-        return self.epsilon, _Amplitude(kind, value)
+        return self.epsilon, _Amplitude(self.parameter, value)
 
     def derivative(self, out: dict[str, Any]) -> np.ndarray:
         return out["d_epsilon"] if self.parameter == "epsilon" else out["d_level"]
 
 
-def _continuation_setup(system, mode, parameter, epsilon, energy, modal_amplitude, energy_per_epsilon, formulation,
-                        release_sign):
+def _check_parameter(parameter: str, epsilon: float | None, verb: str) -> None:
+    """``parameter`` is one of :data:`_PARAMETERS`; ε is given exactly when it is not the one that ``verb``s."""
     if parameter not in _PARAMETERS:
         raise ProblemError(f"parameter must be one of {_PARAMETERS}, got {parameter!r}")
+    if parameter == "epsilon" and epsilon is not None:
+        raise ProblemError(f"parameter='epsilon' {verb} ε: do not also pass epsilon=")
+    if parameter != "epsilon" and epsilon is None:
+        raise ProblemError(f"parameter={parameter!r} needs the fixed epsilon=")
+
+
+def _continuation_setup(system, mode, parameter, epsilon, energy, modal_amplitude, energy_per_epsilon, formulation,
+                        release_sign):
+    _check_parameter(parameter, epsilon, "varies")
     if parameter == "epsilon":
-        if epsilon is not None:
-            raise ProblemError("parameter='epsilon' varies ε: do not also pass epsilon=")
         problem = NNMShooting(system, mode, energy=energy, modal_amplitude=modal_amplitude,
                               energy_per_epsilon=energy_per_epsilon, formulation=formulation, release_sign=release_sign)
         return problem, _Path("epsilon", problem.amplitude, None)
-    if epsilon is None:
-        raise ProblemError(f"parameter={parameter!r} needs the fixed epsilon=")
     if energy is not None or modal_amplitude is not None or energy_per_epsilon is not None:
         raise ProblemError(f"parameter={parameter!r} varies the amplitude itself: do not pass energy=, "
                            "modal_amplitude= or energy_per_epsilon=")
     eps = _check_epsilon(epsilon)
-    seed = {"energy": 1.0} if parameter == "energy" else {"modal_amplitude": 1.0}
-    problem = NNMShooting(system, mode, formulation=formulation, release_sign=release_sign, **seed)
+    # the amplitude value is a placeholder: _Path.at sets it to λ at every point
+    problem = NNMShooting(system, mode, formulation=formulation, release_sign=release_sign, **{parameter: 1.0})
     return problem, _Path(parameter, None, eps)
 
 
@@ -309,13 +313,30 @@ class _Stepper(ABC):
                  min_step: float | None, max_step: float | None, max_halvings: int, options: dict[str, Any]) -> None:
         self.problem, self.path, self.start, self.stop = problem, path, start, stop
         self.direction = 1.0 if stop > start else -1.0
+        self.span = abs(stop - start)
         self.max_halvings = max_halvings
         self.options = options
-        self.label = path.parameter
-        self.step = abs(step) if step else abs(stop - start) / 50.0
+        self.step = abs(step) if step else self.default_step()
+        # bounds of the step (the upper one is used by "arclength" only)
+        self.h_min = abs(min_step) if min_step else self.step / 2.0**max_halvings
+        self.h_max = abs(max_step) if max_step else 4.0 * self.step
+
+    @property
+    def label(self) -> str:
+        return self.path.parameter
+
+    def default_step(self) -> float:
+        """The initial step when none is given: 1/50 of the parameter range."""
+        return self.span / 50.0
 
     def first(self, value: float) -> NNMResult:
-        return _first_point(self.problem, self.path, value, self.options)
+        """The first point, solved from the linear mode."""
+        problem = self.problem
+        eps, amplitude = self.path.at(value)
+        impossible = _impossible_amplitude(problem, eps, amplitude)
+        if impossible:
+            return problem._failure(eps, impossible)
+        return problem._solve(problem._linear_guess(eps, amplitude), eps, amplitude, min_mode_share=0.5, **self.options)
 
     def begin(self, first: NNMResult, value: float) -> str | None:
         return None
@@ -340,11 +361,7 @@ class _Natural(_Stepper):
 
     name = "natural"
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        super().__init__(*args, **kwargs)
-        self.halvings = 0
-        min_step = kwargs.get("min_step")
-        self.h_min = abs(min_step) if min_step else self.step / 2.0**self.max_halvings
+    halvings = 0  # failures since the last accepted point
 
     def guess(self, points: list[NNMResult], values: list[float], target: float) -> np.ndarray:
         guess = _unknowns_of(self.problem, points[-1])
@@ -355,7 +372,7 @@ class _Natural(_Stepper):
         return guess
 
     def solve(self, value: float, guess: np.ndarray) -> NNMResult:
-        return _solve_fixed(self.problem, self.path, value, guess, self.options)
+        return self.problem._solve(guess, *self.path.at(value), **self.options)
 
     def advance(self, points: list[NNMResult], values: list[float]) -> _Attempt:
         target = values[-1] + self.direction * self.step
@@ -381,37 +398,8 @@ class _Natural(_Stepper):
         self.halvings = 0
 
 
-def _first_point(problem: NNMShooting, path: _Path, value: float, options: dict[str, Any]) -> NNMResult:
-    eps, amplitude = path.at(value)
-    impossible = _impossible_amplitude(problem, eps, amplitude)
-    if impossible:
-        return _failed(problem.mode, eps, problem.linear_frequency, problem.n, impossible, problem.formulation, 0,
-                       problem.flow_evaluations)
-    x0, _ = problem._guess_amplitude(eps, amplitude)
-    period = _TWO_PI / problem.linear_frequency
-    z0 = np.r_[x0, period] if problem.formulation == "symmetric" else np.r_[x0, np.zeros(problem.n), period]
-    return _solve_fixed(problem, path, value, z0, options, min_mode_share=0.5)
-
-
-def _solve_fixed(problem: NNMShooting, path: _Path, value: float, z0: np.ndarray, options: dict[str, Any],
-                 min_mode_share: float | None = None) -> NNMResult:
-    eps, amplitude = path.at(value)
-    x_guess, _, period_guess = problem.split(z0)
-    problem.set_scales(eps, x_guess if np.max(np.abs(x_guess)) > 0 else None, period_guess, amplitude)
-    outcome = _newton(lambda z: problem.evaluate(z, eps, amplitude=amplitude), z0, problem.column_scales(),
-                      tol=options["tol"], max_iterations=options["max_iterations"])
-    if not outcome.success:
-        return _failed(problem.mode, eps, problem.linear_frequency, problem.n, outcome.message, problem.formulation,
-                       outcome.iterations, problem.flow_evaluations)
-    return problem.verify(outcome.unknowns, eps, verify_tol=options["verify_tol"],
-                          stability_tol=options["stability_tol"], iterations=outcome.iterations, amplitude=amplitude,
-                          min_mode_share=min_mode_share)
-
-
 def _unknowns_of(problem: NNMShooting, result: NNMResult) -> np.ndarray:
-    if problem.formulation == "symmetric":
-        return np.r_[result.release_position, result.period]
-    return np.r_[result.release_position, result.release_velocity, result.period]
+    return problem._join(result.release_position, result.release_velocity, result.period)
 
 
 # --------------------------------------------------------------------------- #
@@ -422,14 +410,9 @@ class _Arclength(_Stepper):
 
     name = "arclength"
 
-    def __init__(self, problem: NNMShooting, path: _Path, start: float, stop: float, *, step: float | None,
-                 min_step: float | None, max_step: float | None, max_halvings: int, options: dict[str, Any]) -> None:
-        super().__init__(problem, path, start, stop, step=step, min_step=min_step, max_step=max_step,
-                         max_halvings=max_halvings, options=options)
-        self.span = abs(stop - start)
-        self.step = h = abs(step) if step else 1.0 / 50.0
-        self.h_max = abs(max_step) if max_step else 4.0 * h
-        self.h_min = abs(min_step) if min_step else h / 2.0**max_halvings
+    def default_step(self) -> float:
+        """The initial step when none is given: 1/50 in scaled arclength (λ is scaled by the range)."""
+        return 1.0 / 50.0
 
     def scales_at(self, result: NNMResult, value: float) -> np.ndarray:
         eps, amplitude = self.path.at(value)
@@ -489,7 +472,7 @@ class _Arclength(_Stepper):
         if direction * (value - stop) >= 0:  # crossed stop: land exactly on it, from the interpolated guess
             fraction = (stop - values[-1]) / (value - values[-1])
             guess = w[:-1] + fraction * (candidate[:-1] - w[:-1])
-            result = _solve_fixed(problem, path, stop, guess, options)
+            result = problem._solve(guess, *path.at(stop), **options)
             iterations += result.newton_iterations
             if result.success:
                 return _Attempt(iterations, stop, result, complete=True)
@@ -555,7 +538,7 @@ def _seed_solve(problem: NNMShooting, path: _Path, value: float, guess: np.ndarr
     problem.set_scales(eps, guess[:n] if np.max(np.abs(guess[:n])) > 0 else None, float(guess[2 * n]), amplitude)
     impossible = _impossible_amplitude(problem, eps, amplitude)
     if impossible:
-        return _failed(problem.mode, eps, problem.linear_frequency, n, impossible, "seed", 0, problem.flow_evaluations)
+        return problem._failure(eps, impossible, label="seed")
     columns = np.r_[np.full(n, problem.position_scale), np.full(n, problem.velocity_scale), problem.period_scale]
     solution = scipy.optimize.root(lambda y: _seed_residual(problem, eps, amplitude, y * columns), guess / columns,
                                    method="hybr", options={"xtol": 1e-12})
@@ -563,9 +546,8 @@ def _seed_solve(problem: NNMShooting, path: _Path, value: float, guess: np.ndarr
     norm = float(np.max(np.abs(_seed_residual(problem, eps, amplitude, unknowns))))
     iterations = int(solution.nfev)  # hybr has no Jacobian: its cost is its function evaluations
     if not norm <= verify_tol:
-        return _failed(problem.mode, eps, problem.linear_frequency, n,
-                       f"hybr did not converge (residual {norm:.1e}; {solution.message})", "seed", iterations,
-                       problem.flow_evaluations)
+        return problem._failure(eps, f"hybr did not converge (residual {norm:.1e}; {solution.message})", iterations,
+                                label="seed")
     saved = problem.formulation
     problem.formulation = "full"
     try:
@@ -580,9 +562,7 @@ class _Seed(_Natural):
 
     name = "seed"
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        super().__init__(*args, **kwargs)
-        self.label = "ε"
+    label = "ε"
 
     def first(self, value: float) -> NNMResult:
         eps0, amplitude0 = self.path.at(value)
@@ -609,8 +589,7 @@ def _sweep_task(value: float, *, system: UnilateralSystem, mode: int, parameter:
                 options: dict[str, Any]) -> NNMResult:
     if parameter == "epsilon":
         return nnm_point(system, value, mode, **options)
-    key = "energy" if parameter == "energy" else "modal_amplitude"
-    return nnm_point(system, epsilon, mode, **{key: value}, **options)
+    return nnm_point(system, epsilon, mode, **{parameter: value}, **options)
 
 
 def nnm_sweep(
@@ -652,12 +631,7 @@ def nnm_sweep(
     >>> [round(r.frequency, 10) for r in results] == [round(2 * (1 + e)**0.5 / (1 + (1 + e)**0.5), 10) for e in (0.1, 0.2, 0.3)]
     True
     """
-    if parameter not in _PARAMETERS:
-        raise ProblemError(f"parameter must be one of {_PARAMETERS}, got {parameter!r}")
-    if parameter == "epsilon" and epsilon is not None:
-        raise ProblemError("parameter='epsilon' sweeps ε: do not also pass epsilon=")
-    if parameter != "epsilon" and epsilon is None:
-        raise ProblemError(f"parameter={parameter!r} needs the fixed epsilon=")
+    _check_parameter(parameter, epsilon, "sweeps")
     values = [float(v) for v in values]
     task = partial(_sweep_task, system=system, mode=mode, parameter=parameter, epsilon=epsilon, options=options)
     if executor is None:

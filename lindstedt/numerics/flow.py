@@ -73,7 +73,6 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 import scipy.linalg
-import scipy.optimize
 
 from .._errors import ProblemError
 from .._system import UnilateralSystem
@@ -82,7 +81,6 @@ from .switching import _Bracket, _Counters, _first_exit, _SearchFailure
 __all__ = ["ExactFlow", "FlowResult", "FlowMapResult", "SwitchEvent"]
 
 _EPS = float(np.finfo(float).eps)
-_TINY = float(np.finfo(float).tiny)
 #: half-width of the band of rounding-level excursions, in eps × magnitude of g
 _BAND_FACTOR = 64.0
 #: |g| below this many eps × magnitude counts as "on the switching surface"
@@ -305,7 +303,7 @@ def _refine_symmetric(stiffness_l: np.ndarray, mass_l: np.ndarray, basis: np.nda
     identity = np.eye(n, dtype=_LONG)
     X = basis.astype(_LONG)
 
-    def step(X: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def step(X: np.ndarray) -> np.ndarray:
         residual = identity - X.T @ mass_l @ X
         rayleigh = X.T @ stiffness_l @ X
         values = np.diag(rayleigh) / (1 - np.diag(residual))
@@ -315,10 +313,10 @@ def _refine_symmetric(stiffness_l: np.ndarray, mass_l: np.ndarray, basis: np.nda
             separated, (rayleigh + values[None, :] * residual) / np.where(separated, difference, 1), residual / 2
         )
         np.fill_diagonal(correction, np.diag(residual) / 2)
-        return X + X @ correction, residual, rayleigh
+        return X + X @ correction
 
     for _ in range(3):
-        X, residual, rayleigh = step(X)
+        X = step(X)
     rayleigh = X.T @ stiffness_l @ X
     for group in _clusters(np.diag(rayleigh), _CLUSTER_RTOL):
         block = rayleigh[np.ix_(group, group)]
@@ -328,7 +326,7 @@ def _refine_symmetric(stiffness_l: np.ndarray, mass_l: np.ndarray, basis: np.nda
         for _ in range(2):
             rotation = rotation + rotation @ ((np.eye(len(group), dtype=_LONG) - rotation.T @ rotation) / 2)
         X[:, group] = X[:, group] @ rotation
-    X, residual, rayleigh = step(X)
+    X = step(X)
     rayleigh = X.T @ stiffness_l @ X
     residual = identity - X.T @ mass_l @ X
     off_diagonal = rayleigh - np.diag(np.diag(rayleigh))
@@ -542,19 +540,14 @@ class ExactFlow:
         tol_rate = _SURFACE_FACTOR * _EPS * (abs_A @ velocity_scale)
         forces = self._abs_stiffness_all @ position_scale + abs(self.epsilon) * self._abs_W @ np.abs(system.b)
         tol_curvature = _SURFACE_FACTOR * _EPS * (abs_A @ (self._mass_inverse_abs @ forces))
-        state = []
-        for i, (g, g1, g2, tol0, tol1, tol2) in enumerate(
-            zip(gap.tolist(), rate.tolist(), curvature.tolist(), tol_gap.tolist(), tol_rate.tolist(), tol_curvature.tolist())
-        ):
-            if abs(g) > tol0:
-                state.append(g > 0)
-            elif abs(g1) > tol1:
-                state.append(g1 > 0)
-            elif abs(g2) > tol2:
-                state.append(g2 > 0)
-            else:
-                state.append(bool(previous[i]) if previous is not None else False)
-        return tuple(state)
+        kept = np.zeros(len(gap), dtype=bool) if previous is None else np.array(previous, dtype=bool)
+        # the sign of g beyond rounding; on the surface that of g', then of g''; else the previous state
+        state = np.where(
+            np.abs(gap) > tol_gap,
+            gap > 0,
+            np.where(np.abs(rate) > tol_rate, rate > 0, np.where(np.abs(curvature) > tol_curvature, curvature > 0, kept)),
+        )
+        return tuple(bool(on) for on in state)
 
     def _next_event(
         self, mode: _ContactMode, q0: np.ndarray, p0: np.ndarray, tau_max: float, counters: _Counters
@@ -624,7 +617,8 @@ class ExactFlow:
             except _SearchFailure as failure:
                 success, message = False, f"stopped at t = {float(t_l)}: {failure}"
                 break
-            tau_l = t_end_l - t_l if (tau_event is None and last_chunk) else _LONG(tau_max if tau_event is None else tau_event)
+            reaches_end = tau_event is None and last_chunk
+            tau_l = t_end_l - t_l if reaches_end else _LONG(tau_max if tau_event is None else tau_event)
             n_arcs += 1
             if dense:
                 arc_starts.append(t_l)
@@ -635,7 +629,7 @@ class ExactFlow:
             if jacobian is not None:
                 jacobian = mode.transition(float(tau_l)) @ jacobian
             t_l = t_l + tau_l
-            if tau_event is None and last_chunk:
+            if reaches_end:
                 t_l = t_end_l
                 break
             # rounding of the evaluated state is relative to the arc's magnitudes, not to (x, v)
@@ -663,8 +657,13 @@ class ExactFlow:
             "x": x_l.astype(float),
             "v": v_l.astype(float),
             "events": tuple(events),
-            "n_arcs": n_arcs,
-            "counters": counters,
+            # the cost counters shared by FlowResult and FlowMapResult
+            "cost": {
+                "n_switches": len(events),
+                "n_root_solves": counters.root_solves,
+                "n_arcs": n_arcs,
+                "n_evaluations": counters.evaluations,
+            },
             "decompositions": cost["decompositions"],
             "visited": tuple(tuple(i for i, on in enumerate(state) if on) for state in visited),
             "arcs": (arc_starts, arc_modes, arc_q0, arc_p0),
@@ -702,15 +701,10 @@ class ExactFlow:
         start_array = np.array(starts, dtype=_LONG)
         q0_array = np.array(q0s, dtype=_LONG).reshape(len(q0s), self.system.n_dof)
         p0_array = np.array(p0s, dtype=_LONG).reshape(len(p0s), self.system.n_dof)
-        mode_ids: dict[int, int] = {}
-        unique_modes: list[_ContactMode] = []
-        arc_mode = np.empty(len(modes), dtype=int)
-        for k, mode in enumerate(modes):
-            key = id(mode)
-            if key not in mode_ids:
-                mode_ids[key] = len(unique_modes)
-                unique_modes.append(mode)
-            arc_mode[k] = mode_ids[key]
+        # the distinct contact modes in order of first use, and each arc's index into them
+        unique_modes = list({id(mode): mode for mode in modes}.values())
+        mode_index = {id(mode): k for k, mode in enumerate(unique_modes)}
+        arc_mode = np.array([mode_index[id(mode)] for mode in modes], dtype=int)
         n = self.system.n_dof
         final_x, final_v = run["x"].copy(), run["v"].copy()
 
@@ -732,7 +726,6 @@ class ExactFlow:
                     velocities[selected] = v_l.astype(float)
             return positions, velocities
 
-        counters: _Counters = run["counters"]
         return FlowResult(
             success=run["success"],
             message=run["message"],
@@ -741,10 +734,7 @@ class ExactFlow:
             position=final_x,
             velocity=final_v,
             events=run["events"],
-            n_switches=len(run["events"]),
-            n_root_solves=counters.root_solves,
-            n_arcs=run["n_arcs"],
-            n_evaluations=counters.evaluations,
+            **run["cost"],
             n_decompositions=run["decompositions"],
             contact_states=run["visited"],
             _evaluator=evaluator,
@@ -764,15 +754,11 @@ class ExactFlow:
         ([1.0], (2, 2))
         """
         run = self._run(x0, v0, t, dense=False, sensitivity=sensitivity)
-        counters: _Counters = run["counters"]
         return FlowMapResult(
             success=run["success"],
             message=run["message"],
             position=run["x"],
             velocity=run["v"],
             sensitivity=run["jacobian"],
-            n_switches=len(run["events"]),
-            n_root_solves=counters.root_solves,
-            n_arcs=run["n_arcs"],
-            n_evaluations=counters.evaluations,
+            **run["cost"],
         )

@@ -170,19 +170,6 @@ class NNMResult:
         )
 
 
-def _failed(mode: int, epsilon: float, linear_frequency: float, n: int, message: str, formulation: str,
-            iterations: int, flows: int, x0: np.ndarray | None = None) -> NNMResult:
-    position = np.full(n, np.nan) if x0 is None else np.array(x0, dtype=float)
-    return NNMResult(
-        success=False, message=message, mode=mode, epsilon=epsilon, frequency=float("nan"), period=float("nan"),
-        linear_frequency=linear_frequency, release_position=position, release_velocity=np.full(n, np.nan),
-        modal_coordinates=np.full(n, np.nan), energy=float("nan"), floquet_multipliers=None, stable=None,
-        residual=float("nan"), n_switches=0, mode_share=float("nan"), formulation=formulation, newton_iterations=iterations,
-        flow_evaluations=flows,
-    )
-
-
-
 @dataclass(frozen=True)
 class ContinuationProgress:
     """Passed to the continuation callback after every accepted point.
@@ -283,14 +270,10 @@ class NNMBranch:
 
 
 def _branch_events(points: Sequence[NNMResult], values: Sequence[float]) -> tuple[tuple[int, ...], ...]:
-    folds, stability, contact = [], [], []
+    """Folds (the parameter turns back at point k), stability and contact changes (between points k and k + 1)."""
     increments = np.diff(np.asarray(values, dtype=float))
-    for k in range(len(increments) - 1):
-        if increments[k] * increments[k + 1] < 0:
-            folds.append(k + 1)
-    for k in range(len(points) - 1):
-        if points[k].stable != points[k + 1].stable:
-            stability.append(k)
-        if points[k].contact != points[k + 1].contact:
-            contact.append(k)
-    return tuple(folds), tuple(stability), tuple(contact)
+    folds = tuple(int(k) + 1 for k in np.flatnonzero(increments[:-1] * increments[1:] < 0))
+    pairs = list(zip(points[:-1], points[1:]))
+    stability = tuple(k for k, (a, b) in enumerate(pairs) if a.stable != b.stable)
+    contact = tuple(k for k, (a, b) in enumerate(pairs) if a.contact != b.contact)
+    return folds, stability, contact

@@ -87,7 +87,7 @@ from .._errors import ConvergenceError, ProblemError
 from .flow import ExactFlow
 from .._parsing import parse_float
 from .._system import UnilateralSystem
-from .results import NNMResult, _failed
+from .results import NNMResult
 from .sensitivity import _check_epsilon, _integrate
 
 __all__ = ["NNMShooting", "nnm_energy", "nnm_point"]
@@ -311,11 +311,18 @@ class NNMShooting:
 
     def initial_guess(self, epsilon: float) -> np.ndarray:
         """Unknowns of the linear mode j with the requested amplitude (period 2π/λ_j)."""
-        x0, _ = self._guess_amplitude(_check_epsilon(epsilon))
-        period = _TWO_PI / self.linear_frequency
+        return self._linear_guess(_check_epsilon(epsilon))
+
+    def _linear_guess(self, epsilon: float, amplitude: _Amplitude | None = None) -> np.ndarray:
+        """:meth:`initial_guess` for another amplitude condition (default: this problem's)."""
+        x0, _ = self._guess_amplitude(epsilon, amplitude)
+        return self._join(x0, np.zeros(self.n), _TWO_PI / self.linear_frequency)
+
+    def _join(self, x0: np.ndarray, v0: np.ndarray, period: float) -> np.ndarray:
+        """The unknown vector of (X0, X1, T): the inverse of :meth:`split`."""
         if self.formulation == "symmetric":
             return np.r_[x0, period]
-        return np.r_[x0, np.zeros(self.n), period]
+        return np.r_[x0, v0, period]
 
     def split(self, unknowns: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
         """(X0, X1, T) from the unknown vector."""
@@ -396,9 +403,10 @@ class NNMShooting:
                 out["d_epsilon"] = np.r_[dz[n:] / vs, amp_eps / As]
             else:
                 out["d_epsilon"] = np.r_[dz[:n] / xs, dz[n:] / vs, amp_eps / As, 0.0]
-        level_row = -amplitude.d_target_d_value(epsilon) / As
-        out["d_level"] = np.r_[np.zeros(len(residual) - (1 if self.formulation == "symmetric" else 2)), level_row,
-                               np.zeros(0 if self.formulation == "symmetric" else 1)]
+        # only the amplitude row depends on the amplitude value
+        d_level = np.zeros(len(residual))
+        d_level[n if self.formulation == "symmetric" else 2 * n] = -amplitude.d_target_d_value(epsilon) / As
+        out["d_level"] = d_level
         return out
 
     def residual(self, unknowns: Any, epsilon: float) -> np.ndarray:
@@ -437,15 +445,12 @@ class NNMShooting:
         amplitude = amplitude or self.amplitude
         label = formulation_label or self.formulation
         x0, v0, period = self.split(unknowns)
-        n = self.n
         if not (math.isfinite(period) and period > 0):
-            return _failed(self.mode, epsilon, self.linear_frequency, n, f"invalid period T = {period}", label,
-                           iterations, self.flow_evaluations, x0)
+            return self._failure(epsilon, f"invalid period T = {period}", iterations, label=label, x0=x0)
         self.flow_evaluations += 1
         trajectory = _integrate(self._flow(epsilon), x0, v0, period, sensitivity=True, d_epsilon=False)
         if not trajectory.success:
-            return _failed(self.mode, epsilon, self.linear_frequency, n, trajectory.message, label, iterations,
-                           self.flow_evaluations, x0)
+            return self._failure(epsilon, trajectory.message, iterations, label=label, x0=x0)
         frequency = _TWO_PI / period
         scale = max(float(np.max(np.abs(x0))), float(np.max(np.abs(v0))) / frequency, np.finfo(float).tiny)
         residual = max(
@@ -459,41 +464,58 @@ class NNMShooting:
         multipliers = np.linalg.eigvals(monodromy)
         multipliers = multipliers[np.argsort(np.abs(multipliers - 1.0), kind="stable")]
         stable = bool(np.max(np.abs(multipliers)) <= 1.0 + stability_tol)
-        energy = nnm_energy(self.system, x0, v0, epsilon)
         share, dominant = self.mode_share(x0, v0)
-        common = dict(
-            mode=self.mode, epsilon=epsilon, frequency=frequency, period=period,
+        if not (residual <= verify_tol and amplitude_error <= verify_tol):
+            success, message = False, (
+                f"verification failed: periodicity residual {residual:.2e}, amplitude residual "
+                f"{amplitude_error:.2e} over one full period (verify_tol = {verify_tol:.1e}){note}"
+            )
+        elif min_mode_share is not None and share < min_mode_share:
+            success, message = False, (
+                f"converged to a periodic orbit that is not the NNM of mode {self.mode}: mode {dominant} carries "
+                f"the most modal energy, mode {self.mode} only {share:.1%} (< {min_mode_share:.0%}); start closer "
+                "(continue_nnm from the linear mode, or initial_guess=)"
+            )
+        else:
+            contact = "" if trajectory.n_switches else "; no contact along the orbit: it is the linear mode (ω = λ_j)"
+            success, message = True, (
+                f"converged in {iterations} iterations, verified residual {residual:.1e}{contact}{note}"
+            )
+        return NNMResult(
+            success=success, message=message, mode=self.mode, epsilon=epsilon, frequency=frequency, period=period,
             linear_frequency=self.linear_frequency, release_position=np.array(x0), release_velocity=np.array(v0),
-            modal_coordinates=self.projector @ x0, energy=energy, floquet_multipliers=multipliers, stable=stable,
-            residual=residual, n_switches=trajectory.n_switches, mode_share=share, formulation=label,
-            newton_iterations=iterations,
+            modal_coordinates=self.projector @ x0, energy=nnm_energy(self.system, x0, v0, epsilon),
+            floquet_multipliers=multipliers, stable=stable, residual=residual, n_switches=trajectory.n_switches,
+            mode_share=share, formulation=label, newton_iterations=iterations,
             flow_evaluations=self.flow_evaluations, monodromy=monodromy,
         )
-        if not (residual <= verify_tol and amplitude_error <= verify_tol):
-            return NNMResult(
-                success=False,
-                message=(
-                    f"verification failed: periodicity residual {residual:.2e}, amplitude residual "
-                    f"{amplitude_error:.2e} over one full period (verify_tol = {verify_tol:.1e}){note}"
-                ),
-                **common,
-            )
-        if min_mode_share is not None and share < min_mode_share:
-            return NNMResult(
-                success=False,
-                message=(
-                    f"converged to a periodic orbit that is not the NNM of mode {self.mode}: mode {dominant} carries "
-                    f"the most modal energy, mode {self.mode} only {share:.1%} (< {min_mode_share:.0%}); start closer "
-                    "(continue_nnm from the linear mode, or initial_guess=)"
-                ),
-                **common,
-            )
-        contact = "" if trajectory.n_switches else "; no contact along the orbit: it is the linear mode (ω = λ_j)"
+
+    def _failure(self, epsilon: float, message: str, iterations: int = 0, *, label: str | None = None,
+                 x0: np.ndarray | None = None) -> NNMResult:
+        """A failed :class:`NNMResult` (NaN orbit data; the release position x0 if known) with the flows used so far."""
+        n = self.n
+        nan = float("nan")
         return NNMResult(
-            success=True,
-            message=f"converged in {iterations} iterations, verified residual {residual:.1e}{contact}{note}",
-            **common,
+            success=False, message=message, mode=self.mode, epsilon=epsilon, frequency=nan, period=nan,
+            linear_frequency=self.linear_frequency,
+            release_position=np.full(n, np.nan) if x0 is None else np.array(x0, dtype=float),
+            release_velocity=np.full(n, np.nan), modal_coordinates=np.full(n, np.nan), energy=nan,
+            floquet_multipliers=None, stable=None, residual=nan, n_switches=0, mode_share=nan,
+            formulation=label or self.formulation, newton_iterations=iterations, flow_evaluations=self.flow_evaluations,
         )
+
+    def _solve(self, z0: np.ndarray, epsilon: float, amplitude: _Amplitude | None = None, *, tol: float,
+               max_iterations: int, verify_tol: float, stability_tol: float,
+               min_mode_share: float | None = None) -> NNMResult:
+        """Newton from the unknowns z0 at fixed (ε, amplitude), scaled by z0, then the full-period verification."""
+        x_guess, _, period_guess = self.split(z0)
+        self.set_scales(epsilon, x_guess if np.max(np.abs(x_guess)) > 0 else None, period_guess, amplitude)
+        outcome = _newton(lambda z: self.evaluate(z, epsilon, amplitude=amplitude), z0, self.column_scales(), tol=tol,
+                          max_iterations=max_iterations)
+        if not outcome.success:
+            return self._failure(epsilon, outcome.message, outcome.iterations, x0=self.split(outcome.unknowns)[0])
+        return self.verify(outcome.unknowns, epsilon, verify_tol=verify_tol, stability_tol=stability_tol,
+                           iterations=outcome.iterations, amplitude=amplitude, min_mode_share=min_mode_share)
 
 
 # --------------------------------------------------------------------------- #
@@ -611,10 +633,8 @@ def _guess_unknowns(problem: NNMShooting, epsilon: float, initial_guess: Any) ->
         except (TypeError, ValueError):
             raise ProblemError("initial_guess must be an NNMResult, a pair (X0, T) or None") from None
         v0 = np.zeros(problem.n)
-    x0 = np.asarray(x0, dtype=float).reshape(problem.n)
-    if problem.formulation == "symmetric":
-        return np.r_[x0, float(period)]
-    return np.r_[x0, np.asarray(v0, dtype=float).reshape(problem.n), float(period)]
+    return problem._join(np.asarray(x0, dtype=float).reshape(problem.n), np.asarray(v0, dtype=float).reshape(problem.n),
+                         float(period))
 
 
 def nnm_point(
@@ -684,18 +704,10 @@ def nnm_point(
     problem = NNMShooting(system, mode, energy=energy, modal_amplitude=modal_amplitude,
                           energy_per_epsilon=energy_per_epsilon, formulation=formulation, release_sign=release_sign)
     epsilon = _check_epsilon(epsilon)
-    n = system.n_dof
     impossible = _impossible_amplitude(problem, epsilon, problem.amplitude)
     if impossible:
-        return _failed(problem.mode, epsilon, problem.linear_frequency, n, impossible, formulation, 0, 0)
-    z0 = _guess_unknowns(problem, epsilon, initial_guess)
-    x_guess, _, period_guess = problem.split(z0)
-    problem.set_scales(epsilon, x_guess if np.max(np.abs(x_guess)) > 0 else None, period_guess)
-    outcome = _newton(lambda z: problem.evaluate(z, epsilon), z0, problem.column_scales(), tol=tol,
-                      max_iterations=max_iterations)
-    if not outcome.success:
-        return _failed(problem.mode, epsilon, problem.linear_frequency, n, outcome.message, formulation,
-                       outcome.iterations, problem.flow_evaluations, problem.split(outcome.unknowns)[0])
-    return problem.verify(outcome.unknowns, epsilon, verify_tol=verify_tol, stability_tol=stability_tol,
-                          iterations=outcome.iterations, min_mode_share=min_mode_share)
+        return problem._failure(epsilon, impossible)
+    return problem._solve(_guess_unknowns(problem, epsilon, initial_guess), epsilon, tol=tol,
+                          max_iterations=max_iterations, verify_tol=verify_tol, stability_tol=stability_tol,
+                          min_mode_share=min_mode_share)
 
