@@ -5,8 +5,8 @@ with an independent exact reference at high precision:
 
 1. Duffing ``u'' + u + ε u³ = 0``, ``u(0) = 1``, ``u'(0) = 0``: the Lindstedt–Poincaré (LP) frequency truncated
    at order N (``lindstedt.expand("u**3", order=N, a0=1, omega0=1).frequency(ε)``), the elliptic closed form
-   (``_reference_duffing.duffing_exact_frequency``) and the energy-integral quadrature
-   (``_reference_quadrature.conservative_frequency``) at several working precisions, and scipy's DOP853
+   (``lindstedt.references.duffing_exact_frequency``) and the energy-integral quadrature
+   (``lindstedt.references.conservative_frequency``) at several working precisions, and scipy's DOP853
    measuring the period (event at u' = 0) at several tolerances.
 2. Unilateral spring ``u'' + u + ε (u − κ)_+ = 0``, κ = 1/3, ``u(0) = 1``: the expansion (``numeric=True``,
    orders 1…6), the library's closed-form period (``_reference_piecewise``), Newton shooting on the exact
@@ -588,9 +588,9 @@ def _section_duffing(data: dict, quick: bool, figures: list[Path]) -> list[str]:
           "* **LP, frequency (warm)**: `expansion.frequency(ε)` on an expansion already computed (sympy rationals "
           "→ floats → `polyval`, plus the ω_{N+1} ε^{N+1} warning check); *lambdified*: a call of "
           "`expansion.lambdify(\"frequency\")` (sympy-generated Python, built once untimed), ε → float.",
-          "* **elliptic**: `_reference_duffing.duffing_exact_frequency(ε, amplitude=1, precision=d)` (π√(1+ε)/(2K(m))), "
+          "* **elliptic**: `lindstedt.references.duffing_exact_frequency(ε, amplitude=1, precision=d)` (π√(1+ε)/(2K(m))), "
           "one call.",
-          "* **quadrature**: `_reference_quadrature.conservative_frequency(u**3, ε, a0=1, precision=d)` (period from the "
+          "* **quadrature**: `lindstedt.references.conservative_frequency(u**3, ε, a0=1, precision=d)` (period from the "
           "energy integral by a refined trapezoid rule), one call; its own error estimate in the notes.",
           "* **DOP853**: `scipy.integrate.solve_ivp(method=\"DOP853\", rtol, atol = rtol·1e-3)` from (1, 0) with a "
           "terminal event at u' = 0 (upward crossing: the turning point u = −1 at t = T/2), ω = π / t½; one call.",
@@ -660,7 +660,7 @@ def _section_unilateral(data: dict, quick: bool, figures: list[Path]) -> list[st
           ".frequency(ε)` (30-digit floats), caches dropped as in problem 1 (a warm-up with κ = 1/4 ran first); "
           "*evaluation only* is `.frequency(ε)` on the computed expansion, or a call of its `lambdify(\"frequency\")`; "
           "notes as in problem 1.",
-          "* **closed form**: `_reference_piecewise.piecewise_linear_exact_frequency(ε, a=1, b=1/3, a0=1, precision=d)`.",
+          "* **closed form**: `lindstedt.references.piecewise_linear_exact_frequency(ε, a=1, b=1/3, a0=1, precision=d)`.",
           "* **shooting**: `lindstedt.nnm_point(UnilateralSystem.one_dof(1, a=1, b=\"1/3\"), ε, 1, "
           "modal_amplitude=1.0, tol=…, verify_tol=1.0)` — `one_dof(ω0, a, b)` is `u'' + ω0² u + ε (a u − b)_+`, "
           "so a = 1, b = 1/3 is this problem, and modal amplitude 1 is u(0) = 1 (M = [[1]]). Newton on the exact "

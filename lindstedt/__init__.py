@@ -11,7 +11,9 @@ The public API is re-exported here and in the documented public subpackages:
 * :mod:`lindstedt.numerics` — the exact piecewise-linear flow and NNMs by shooting;
 * :mod:`lindstedt.cli` — the ``lindstedt`` command (``python -m lindstedt``).
 
-Modules whose names start with an underscore are private.
+Behind the facade the package is laid out as the pipeline: ``problems/`` →
+``methods/`` → ``engine/`` → ``results/`` → ``export/`` (their public names are
+re-exported here); modules whose names start with an underscore are private.
 
 Examples
 --------
@@ -20,9 +22,9 @@ Examples
 (1, 3/8, -21/256)
 """
 
-from ._all_modes import AllModesFirstOrder, all_modes_first_order
-from ._lindstedt_poincare import LindstedtPoincare, cache_info, clear_cache, expand
-from ._codegen import CodeGenerationError, GeneratedCode, generate_code
+from .methods.all_modes import AllModesFirstOrder, all_modes_first_order
+from .methods.lindstedt_poincare import LindstedtPoincare, cache_info, clear_cache, expand
+from .export.codegen import CodeGenerationError, GeneratedCode, generate_code
 from .algebra.cosine import CosineSeries, SineSeries, solve_harmonic_oscillator
 from ._errors import (
     ConvergenceError,
@@ -33,12 +35,14 @@ from ._errors import (
     ResonanceError,
     UnsupportedNonlinearityError,
 )
-from ._expansion import Expansion, ExpansionValidityWarning, PiecewiseWaveform, Waveform
+from .results.expansion import Expansion, ExpansionValidityWarning, PiecewiseWaveform, Waveform
 from .numerics.flow import ExactFlow
-from ._nnm_expansion import NNMExpansion, NNMProblem, StrainedCoordinatesNNM, nnm
+from .results.nnm import NNMExpansion
+from .problems.nnm import NNMProblem
+from .methods.strained_coordinates import StrainedCoordinatesNNM, nnm
 from .numerics import NNMBranch, NNMResult, continue_nnm, nnm_point, nnm_sweep, seed_example_system
-from ._problem import Oscillator
-from ._system import Modes, UnilateralSystem
+from .problems.oscillator import Oscillator
+from .problems.system import Modes, UnilateralSystem
 from .validate import (
     Spectrum,
     contact_measure,

@@ -43,7 +43,7 @@ import numpy as np
 import sympy
 
 from .._errors import ProblemError
-from .._parsing import parse_real
+from ..problems.parsing import parse_real
 
 __all__ = [
     "KappaLike",

@@ -243,7 +243,7 @@ class BranchHierarchy(LazyOrders):
     Examples
     --------
     >>> from lindstedt.engine.contact import contact_normal_form
-    >>> from lindstedt._problem import Oscillator
+    >>> from lindstedt.problems.oscillator import Oscillator
     >>> form = contact_normal_form(Oscillator("Max(0, u)", a0=1, omega0=1))
     >>> hierarchy = BranchHierarchy(form.system, "initial")
     >>> form.to_expr(hierarchy.squared_frequency(2))

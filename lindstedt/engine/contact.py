@@ -31,8 +31,8 @@ import sympy
 from sympy import QQ, RealField
 
 from .._errors import ProblemError
-from .._piecewise_linear import decompose_piecewise_linear
-from .._problem import DISPLACEMENT, Oscillator
+from ..problems.piecewise_linear import decompose_piecewise_linear
+from ..problems.oscillator import DISPLACEMENT, Oscillator
 from ..algebra.branch import EvaluationPoint
 from .branches import BranchSystem, ContactState, MovingBoundary
 

@@ -33,7 +33,7 @@ import sympy
 from sympy import RealField
 
 from .._errors import ProblemError, ResonanceError
-from .._system import UnilateralSystem
+from ..problems.system import UnilateralSystem
 from ..algebra.branch import EvaluationPoint
 from .branches import BranchSystem, ContactState, MovingBoundary
 

@@ -47,7 +47,7 @@ from sympy import QQ, RealField
 
 from ..algebra.cosine import CosineSeries, solve_harmonic_oscillator, sum_series
 from .._errors import UnsupportedNonlinearityError
-from .._problem import DISPLACEMENT, Oscillator
+from ..problems.oscillator import DISPLACEMENT, Oscillator
 from .branches import FloatBranches
 from .orders import LazyOrders
 
@@ -261,7 +261,7 @@ class SmoothHierarchy(LazyOrders):
 
     Examples
     --------
-    >>> from lindstedt._problem import Oscillator
+    >>> from lindstedt.problems.oscillator import Oscillator
     >>> hierarchy = SmoothHierarchy(normal_form(Oscillator("u**3", a0=1, omega0=1)), "initial")
     >>> print(hierarchy.squared_frequency(1))
     3/4

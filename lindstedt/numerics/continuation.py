@@ -54,7 +54,7 @@ import numpy as np
 import scipy.optimize
 
 from .._errors import ProblemError
-from .._system import UnilateralSystem
+from ..problems.system import UnilateralSystem
 from .results import ContinuationProgress, NNMBranch, NNMResult, _branch_events
 from .sensitivity import _check_epsilon, _integrate
 from .shooting import (

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._errors import ProblemError
-from .._system import UnilateralSystem
+from ..problems.system import UnilateralSystem
 
 __all__ = ["seed_example_system"]
 

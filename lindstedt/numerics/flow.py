@@ -75,7 +75,7 @@ import numpy as np
 import scipy.linalg
 
 from .._errors import ProblemError
-from .._system import UnilateralSystem
+from ..problems.system import UnilateralSystem
 from .switching import _Bracket, _Counters, _first_exit, _SearchFailure
 
 __all__ = ["ExactFlow", "FlowResult", "FlowMapResult", "SwitchEvent"]

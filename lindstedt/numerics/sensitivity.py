@@ -34,8 +34,8 @@ import numpy as np
 
 from .._errors import ConvergenceError, ProblemError
 from .flow import ExactFlow
-from .._parsing import parse_float
-from .._system import UnilateralSystem
+from ..problems.parsing import parse_float
+from ..problems.system import UnilateralSystem
 
 __all__ = ["flow_epsilon_derivative"]
 

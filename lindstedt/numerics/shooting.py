@@ -85,8 +85,8 @@ import numpy as np
 
 from .._errors import ConvergenceError, ProblemError
 from .flow import ExactFlow
-from .._parsing import parse_float
-from .._system import UnilateralSystem
+from ..problems.parsing import parse_float
+from ..problems.system import UnilateralSystem
 from .results import NNMResult
 from .sensitivity import _check_epsilon, _integrate
 

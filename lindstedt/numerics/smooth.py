@@ -25,7 +25,7 @@ __all__ = ["smooth_flow"]
 # --------------------------------------------------------------------------- #
 def _as_scalar_function(f: Any) -> Callable[[float], float]:
     if isinstance(f, str):
-        from .._parsing import parse_expression
+        from ..problems.parsing import parse_expression
 
         u = sympy.Symbol("u", real=True)
         f = parse_expression(f, symbols={"u": u}, what="f")

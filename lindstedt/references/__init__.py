@@ -43,15 +43,15 @@ True
 a*epsilon/(4*omega0) + omega0
 """
 
-from .._nnm_expansion import release_amplitudes_by_series
-from .._reference_duffing import duffing_exact_frequency, duffing_frequency_taylor
-from .._reference_piecewise import (
+from ..methods.strained_coordinates import release_amplitudes_by_series
+from .duffing import duffing_exact_frequency, duffing_frequency_taylor
+from .piecewise import (
     piecewise_linear_exact_frequency,
     piecewise_linear_exact_period,
     piecewise_linear_frequency_taylor,
     piecewise_linear_frequency_taylor_symbolic,
 )
-from .._reference_quadrature import (
+from .quadrature import (
     as_mpmath_number,
     conservative_frequency,
     conservative_period,

@@ -56,7 +56,7 @@ Examples
 2.0
 """
 
-from .._svg import line_plot_svg
+from ..export.svg import line_plot_svg
 from .contact import ContactMeasure, ContactMeasureFit, contact_measure, fitted_contact_measure_order
 from .errors import (
     ConvergenceFit,

@@ -20,7 +20,7 @@ import numpy as np
 import scipy.optimize
 
 from .._errors import ProblemError
-from .._expansion import Expansion
+from ..results.expansion import Expansion
 from .errors import _as_epsilons, _fit_or_nan
 from .solutions import _as_positive, _numeric_problem, _require_expansion, reference_solution
 

@@ -47,7 +47,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from .._errors import ProblemError
-from .._expansion import Expansion
+from ..results.expansion import Expansion
 from .solutions import (
     DEFAULT_ATOL,
     DEFAULT_RTOL,

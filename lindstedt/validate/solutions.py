@@ -36,12 +36,12 @@ import sympy
 from scipy.integrate import solve_ivp
 
 from .._errors import ProblemError, UnsupportedNonlinearityError
-from .._expansion import Expansion
+from ..results.expansion import Expansion
 from ..numerics.flow import ExactFlow, FlowResult
 from ..numerics.smooth import smooth_flow
-from .._piecewise_linear import decompose_piecewise_linear
-from .._problem import DISPLACEMENT, Oscillator
-from .._system import UnilateralSystem
+from ..problems.piecewise_linear import decompose_piecewise_linear
+from ..problems.oscillator import DISPLACEMENT, Oscillator
+from ..problems.system import UnilateralSystem
 
 __all__ = ["ReferenceSolution", "reference_solution", "ExactPeriod", "exact_period"]
 

@@ -35,8 +35,8 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from .._errors import ProblemError
-from .._expansion import Expansion
-from .._problem import Oscillator
+from ..results.expansion import Expansion
+from ..problems.oscillator import Oscillator
 from .solutions import (
     DEFAULT_ATOL,
     DEFAULT_RTOL,

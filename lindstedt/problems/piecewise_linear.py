@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import sympy
 
-from ._errors import UnsupportedNonlinearityError
+from .._errors import UnsupportedNonlinearityError
 
 __all__ = ["LinearInterval", "decompose_piecewise_linear"]
 

@@ -74,8 +74,8 @@ from sympy.polys.ring_series import (
 )
 from sympy.polys.rings import ring
 
-from ._errors import ConvergenceError, ProblemError
-from ._reference_quadrature import omega0_parameter, real_parameter, validate_precision, validate_order
+from .._errors import ConvergenceError, ProblemError
+from .quadrature import omega0_parameter, real_parameter, validate_precision, validate_order
 
 __all__ = ["duffing_exact_frequency", "duffing_frequency_taylor"]
 

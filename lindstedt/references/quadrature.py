@@ -39,8 +39,8 @@ from typing import Any, Callable, Union
 import mpmath
 import sympy
 
-from ._errors import ConvergenceError, OrderError, ParameterError, ProblemError
-from ._parsing import parse_real
+from .._errors import ConvergenceError, OrderError, ParameterError, ProblemError
+from ..problems.parsing import parse_real
 
 __all__ = [
     "conservative_period",

@@ -18,8 +18,8 @@ from typing import Any, Callable, Mapping
 
 import sympy
 
-from ._errors import ParameterError
-from ._problem import Oscillator
+from .._errors import ParameterError
+from ..problems.oscillator import Oscillator
 
 __all__ = ["DerivationAssumptions", "shown_values"]
 

@@ -13,12 +13,12 @@ import threading
 from collections import OrderedDict
 from typing import Any, Callable, Hashable, Mapping, NamedTuple
 
-from ._errors import OrderError, ProblemError
-from ._expansion import Expansion
-from ._problem import Oscillator
-from .engine.branches import BranchHierarchy
-from .engine.contact import contact_normal_form
-from .engine.smooth import MAX_ORDER, SmoothHierarchy, normal_form
+from .._errors import OrderError, ProblemError
+from ..results.expansion import Expansion
+from ..problems.oscillator import Oscillator
+from ..engine.branches import BranchHierarchy
+from ..engine.contact import contact_normal_form
+from ..engine.smooth import MAX_ORDER, SmoothHierarchy, normal_form
 
 __all__ = ["CACHE_MAXSIZE", "CacheInfo", "LindstedtPoincare", "cache_info", "clear_cache", "expand", "validate_order"]
 
@@ -144,7 +144,7 @@ class LindstedtPoincare:
 
     Examples
     --------
-    >>> from lindstedt._problem import Oscillator
+    >>> from lindstedt.problems.oscillator import Oscillator
     >>> method = LindstedtPoincare()
     >>> method.expand(Oscillator("u**3", a0=1, omega0=1), order=2).omega
     (1, 3/8, -21/256)

@@ -47,7 +47,7 @@ import sympy
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.numpy import NumPyPrinter
 
-from ._errors import LindstedtError, ProblemError
+from .._errors import LindstedtError, ProblemError
 
 __all__ = ["GeneratedCode", "generate_code"]
 
@@ -212,8 +212,8 @@ def generate_code(expansion: Any, quantity: str = "frequency", language: str = "
     >>> code.arguments
     ('epsilon', 'a0', 'omega0')
     """
-    from ._expansion import EPSILON, TIME, Expansion
-    from ._nnm_expansion import NNMExpansion
+    from ..results.expansion import EPSILON, TIME, Expansion
+    from ..results.nnm import NNMExpansion
 
     if isinstance(expansion, NNMExpansion):  # numeric coefficients, no free parameters
         return _nnm_code(expansion, quantity, language)
@@ -275,7 +275,7 @@ def _horner_form(expression: sympy.Expr, variable: sympy.Symbol) -> sympy.Expr:
 
 
 def _nnm_code(result: Any, quantity: str, language: str) -> GeneratedCode:
-    from ._expansion import EPSILON
+    from ..results.expansion import EPSILON
 
     if quantity != "frequency":
         raise ProblemError(

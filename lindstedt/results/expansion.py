@@ -41,13 +41,13 @@ from typing import Any, Callable, Mapping
 import numpy as np
 import sympy
 
-from ._assumptions import DerivationAssumptions, shown_values
-from ._errors import OrderError, ParameterError
-from .algebra.branch import Branch, EvaluationPoint
-from ._problem import Oscillator
-from .engine.branches import BranchHierarchy, FloatBranches
-from .engine.contact import PiecewiseNormalForm
-from .engine.smooth import MAX_ORDER, NormalForm, SmoothHierarchy
+from .assumptions import DerivationAssumptions, shown_values
+from .._errors import OrderError, ParameterError
+from ..algebra.branch import Branch, EvaluationPoint
+from ..problems.oscillator import Oscillator
+from ..engine.branches import BranchHierarchy, FloatBranches
+from ..engine.contact import PiecewiseNormalForm
+from ..engine.smooth import MAX_ORDER, NormalForm, SmoothHierarchy
 
 __all__ = ["Expansion", "ExpansionValidityWarning", "Waveform", "PiecewiseWaveform", "STRAINED_TIME", "EPSILON", "TIME"]
 

@@ -58,8 +58,8 @@ from typing import Any
 import mpmath
 import sympy
 
-from ._errors import ConvergenceError, ProblemError
-from ._reference_quadrature import (
+from .._errors import ConvergenceError, ProblemError
+from .quadrature import (
     as_mpmath_number,
     omega0_parameter,
     real_parameter,

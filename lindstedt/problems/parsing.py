@@ -40,7 +40,7 @@ from typing import Any, Callable, Mapping
 
 import sympy
 
-from ._errors import ParameterError, ProblemError
+from .._errors import ParameterError, ProblemError
 
 __all__ = ["ALLOWED_FUNCTIONS", "CONSTANTS", "LIMITS", "ParserLimits", "as_exact", "parse_expression", "parse_float", "parse_real", "parse_value"]
 

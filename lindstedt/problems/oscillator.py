@@ -21,8 +21,8 @@ from typing import Any, Mapping
 
 import sympy
 
-from ._errors import ParameterError, ProblemError
-from ._parsing import ALLOWED_FUNCTIONS, CONSTANTS, as_exact, parse_expression, parse_real, parse_value
+from .._errors import ParameterError, ProblemError
+from .parsing import ALLOWED_FUNCTIONS, CONSTANTS, as_exact, parse_expression, parse_real, parse_value
 
 __all__ = ["Oscillator", "NORMALIZATIONS", "DISPLACEMENT"]
 
@@ -66,7 +66,7 @@ class Oscillator:
     a0 : number, numeric string or sympy expression, optional
         Amplitude (see ``normalization``).  Default: the positive symbol ``a0``.
         Numbers are exact: a float means its binary value, ``"0.1"`` means 1/10
-        (strings are read by the one parser, ``lindstedt._parsing``); a sympy
+        (strings are read by the one parser, ``lindstedt.problems.parsing``); a sympy
         expression may contain real symbols of the caller's own.
     omega0 : number, numeric string or sympy expression, optional
         Linear angular frequency, must be positive.  Default: the positive symbol ``omega0``.

@@ -27,8 +27,8 @@ from typing import Sequence
 
 import numpy as np
 
-from ._errors import ProblemError
-from ._system import UnilateralSystem
+from .._errors import ProblemError
+from ..problems.system import UnilateralSystem
 
 __all__ = ["AllModesFirstOrder", "all_modes_first_order"]
 
@@ -89,7 +89,7 @@ def all_modes_first_order(
 
     Examples
     --------
-    >>> from lindstedt._system import UnilateralSystem
+    >>> from lindstedt.problems.system import UnilateralSystem
     >>> system = UnilateralSystem.chain(2, unilateral=[(0, 0)])
     >>> result = all_modes_first_order(system, [1.0, 0.5])
     >>> [round(value, 12) for value, _ in result.corrections]

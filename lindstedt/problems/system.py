@@ -31,8 +31,8 @@ import numpy as np
 import scipy.linalg
 import sympy
 
-from ._errors import ProblemError
-from ._parsing import parse_real
+from .._errors import ProblemError
+from .parsing import parse_real
 
 __all__ = ["UnilateralSystem", "Modes", "OneDofUnilateral"]
 

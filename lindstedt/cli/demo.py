@@ -20,10 +20,10 @@ import numpy as np
 import sympy
 from scipy.integrate import solve_ivp
 
-from ._lindstedt_poincare import expand
-from ._reference_duffing import duffing_frequency_taylor
-from ._reference_piecewise import piecewise_linear_frequency_taylor, piecewise_linear_frequency_taylor_symbolic
-from ._svg import line_plot_svg
+from ..methods.lindstedt_poincare import expand
+from ..references.duffing import duffing_frequency_taylor
+from ..references.piecewise import piecewise_linear_frequency_taylor, piecewise_linear_frequency_taylor_symbolic
+from ..export.svg import line_plot_svg
 
 __all__ = ["run_demo"]
 

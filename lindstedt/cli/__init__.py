@@ -28,7 +28,7 @@ import argparse
 import sys
 from typing import Any, Sequence
 
-from ._errors import ConvergenceError, LindstedtError, ProblemError
+from .._errors import ConvergenceError, LindstedtError, ProblemError
 
 __all__ = ["main", "build_parser"]
 
@@ -58,7 +58,7 @@ def _parse_parameters(items: Sequence[str]) -> dict[str, str | None]:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``lindstedt`` command."""
-    from . import __version__
+    from .. import __version__
 
     parser = _ArgumentParser(
         prog="lindstedt",
@@ -112,7 +112,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _command_expand(arguments: argparse.Namespace) -> str:
-    from ._lindstedt_poincare import expand
+    from ..methods.lindstedt_poincare import expand
 
     expansion = expand(
         arguments.f,
@@ -136,8 +136,8 @@ def _command_expand(arguments: argparse.Namespace) -> str:
 def _command_nnm(arguments: argparse.Namespace) -> str | tuple[str, int]:
     import json
 
-    from ._nnm_expansion import nnm
-    from ._system import UnilateralSystem
+    from ..methods.strained_coordinates import nnm
+    from ..problems.system import UnilateralSystem
 
     try:
         with open(arguments.system, encoding="utf-8") as handle:
@@ -197,8 +197,8 @@ def _command_derive(arguments: argparse.Namespace) -> str | tuple[str, int]:
 
 
 def _numeric_nnm(system: Any, arguments: argparse.Namespace) -> tuple[str, int]:
-    from .numerics import nnm_point
-    from ._parsing import parse_float
+    from ..numerics import nnm_point
+    from ..problems.parsing import parse_float
 
     if arguments.eps is None:
         raise ProblemError("--numeric needs --eps EPS (the value of epsilon)")
@@ -235,7 +235,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         elif arguments.command == "derive":
             output = _command_derive(arguments)
         else:
-            from ._demo import run_demo
+            from .demo import run_demo
 
             output = run_demo(order=arguments.order, figure_path=arguments.figure or None)
         if isinstance(output, tuple):

@@ -1,0 +1,10 @@
+"""Problems: what is solved, as frozen validated dataclasses, and the one parser of user text.
+
+* :mod:`~lindstedt.problems.parsing` — the AST-whitelist parser (every user string goes through it);
+* :mod:`~lindstedt.problems.oscillator` — ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0``, ``u'(0) = 0``;
+* :mod:`~lindstedt.problems.piecewise_linear` — a continuous piecewise-linear f split into linear intervals;
+* :mod:`~lindstedt.problems.system` — ``M X'' + K X + ε W (A X − b)_+ = 0`` and its linear modes;
+* :mod:`~lindstedt.problems.nnm` — the NNM of one mode of such a system.
+
+The public names are re-exported by :mod:`lindstedt`.
+"""
