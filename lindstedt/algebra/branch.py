@@ -325,9 +325,5 @@ class Branch:
             terms.append(convert(value) * variable**power * trig)
         return sympy.Add(*terms)
 
-    def max_power(self) -> int:
-        """Highest power of s present (−1 for zero)."""
-        return max((power for _, _, power in self.terms), default=-1)
-
     def __repr__(self) -> str:
         return f"Branch({self.terms})"

