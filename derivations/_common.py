@@ -182,13 +182,14 @@ class Sheet:
         omegas = expansion.omega
         parts = [rf"\paragraph{{{heading}}}" if heading else "", expansion.to_latex().strip()]
         if all(is_number(value) for value in omegas) and not all(value.is_Rational for value in omegas):
-            parts.append("Numerically:\n" + align([rf"\omega_{{{k}}} &\approx {decimal(value, LATEX_DIGITS)}"
-                                                   for k, value in enumerate(omegas) if k]))
-        waveforms = expansion.waveforms[: min(expansion.order, WAVEFORM_TERMS) + 1]
+            parts.append("Numerically:\n" + align([rf"\omega_{{{exponent}}} &\approx {decimal(value, LATEX_DIGITS)}"
+                                                   for exponent, value in zip(expansion.exponents, omegas) if exponent]))
+        waveforms = expansion.waveforms[: min(len(omegas) - 1, WAVEFORM_TERMS) + 1]
         shown = ", ".join(f"$v_{{{w.order}}}$" for w in waveforms)
         extension = " (each given on $[0,\\pi]$, extended evenly and $2\\pi$-periodically)" if expansion.is_piecewise else ""
+        gauge = latex(expansion.gauge)
         parts.append(
-            rf"Waveform: $u(t) = \sum_{{k=0}}^{{{expansion.order}}} \varepsilon^{{k}} v_{{k}}(s) + O(\varepsilon^{{{expansion.order + 1}}})$"
+            rf"Waveform: $u(t) = \sum_{{k=0}}^{{{len(omegas) - 1}}} ({gauge})^{{k}} v_{{k}}(s) + O(\varepsilon^{{{latex(len(omegas) * expansion.gauge.as_base_exp()[1])}}})$"
             rf" with $s = \omega(\varepsilon)\, t$; first terms {shown}{extension}:" + "\n"
             + align([rf"v_{{{w.order}}}(s) &= {w.to_latex()}" for w in waveforms])
         )

@@ -1,20 +1,22 @@
 #!/usr/bin/env python3
-"""|a0| = |b|: grazing regime, linear approximation, validity eps^(-1/2).
+"""|a0| = |b|: grazing — a turning point of the unperturbed orbit touches the spring's gap.
 
 Equation (strained time s = omega t)::
 
     u'' + omega0^2 u + eps max(u - b, 0) = 0,    u(0) = a0 = 1,  u'(0) = 0,   b = 1 or b = -1.
 
-When |a0| = |b| the order-zero gap v_0 - b has a double root (a turning point
-touches the switching point): the expansion reduces to the linear approximation
-of the side the orbit lives on (omega = omega0 for b = a0, sqrt(omega0^2 + eps)
-for b = -a0), valid only on t <= C eps^(-1/2): the true frequency is not
-analytic in eps there.
+When |a0| = |b| the order-zero gap v_0 - b has a double root.  For b = a0 the
+release point touches the gap from outside and the orbit never enters it: the
+solution is a0 cos(omega0 t) exactly.  For b = -a0 the orbit is in contact except
+at the far turning point; for eps > 0 the perturbed orbit dips past the gap for
+a time O(eps^(1/2)) each period, so omega(eps) is not analytic: the expansion is
+in powers of eps^(1/2), with the first non-analytic term -8/(3 pi) eps^(5/2)
+(omega0 = 1), and its error falls with the order on t <= C/eps.
 
-Check: for b = a0 the exact solution is a0 cos(omega0 t), so the expansion must
-equal the exact frequency (``lindstedt.references.piecewise_linear_exact_frequency``,
-closed-form period, 30 digits) at eps = 1e-2, 1e-3, 1e-4 to within 1e-25; for
-b = -a0 the non-analytic remainder is tabulated.
+Checks against the exact frequency (``lindstedt.references.piecewise_linear_exact_frequency``,
+closed-form period of the piecewise-linear oscillator, 30 digits) at eps = 1e-2, 1e-3,
+1e-4: for b = a0 the expansion equals it to within 1e-25; for b = -a0 the remainder
+stays within twice the first neglected term.
 
 Run::
 
@@ -55,6 +57,10 @@ DIGITS = 30
 EXACT_TOLERANCE = 1e-25
 OMEGA0 = sympy.Symbol("omega0", positive=True)  # lindstedt's symbol for an unspecified omega0
 EPSILONS = ("1e-2", "1e-3", "1e-4")
+EPSILON = sympy.Symbol("epsilon", real=True)  # lindstedt's symbol for eps in frequency_expr
+#: b = -a0: the remainder over the first neglected term tends to 1 as eps -> 0; at eps = 1e-2 the
+#: next terms add at most |omega_{k+1}/omega_k| eps^(1/2) <= 0.7 (order 1: -1/8 eps^2 then -8/(3 pi) eps^(5/2)).
+REMAINDER_RATIO = 2.0
 
 
 def derive(order: int) -> common.Sheet:
@@ -63,30 +69,33 @@ def derive(order: int) -> common.Sheet:
         equation="u'' + omega0**2*u + epsilon*max(u - b, 0) = 0, u(0) = a0 = 1, b = 1 or b = -1",
     )
     sheet.paragraph(
-        r"When $|a_{0}| = |b|$ the order-zero gap $v_0 - b$ has a double root (a turning point touches the "
-        r"switching point): the expansion reduces to the \emph{linear approximation} of the side the orbit "
-        r"lives on, and it holds only on the shorter time scale $T_\varepsilon \sim \varepsilon^{-1/2}$, "
-        r"because the true frequency is not analytic in $\varepsilon$ there."
+        r"When $|a_{0}| = |b|$ the order-zero gap $v_0 - b$ has a double root: a turning point touches the "
+        r"switching point.  If the perturbed orbit stays on its side, the expansion is the analytic one of that "
+        r"side; if it passes the switching point, it does so for a time $O(\varepsilon^{1/2})$ per period and "
+        r"$\omega(\varepsilon)$ is expanded in powers of $\varepsilon^{1/2}$."
     )
     cases = (
-        ("b = a0", 1, r"$b = a_{0} = 1$: the turning point touches the spring, no contact; $\omega = \omega_{0}$ exactly."),
-        ("b = -a0", -1, r"$b = -a_{0} = -1$: always in contact except at the far turning point; linear frequency $\sqrt{\omega_{0}^{2} + \varepsilon}$."),
+        ("b = a0", 1, r"$b = a_{0} = 1$: the release point touches the spring, no contact; $\omega = \omega_{0}$ exactly."),
+        ("b = -a0", -1, r"$b = -a_{0} = -1$: in contact except at the far turning point, which the perturbed orbit "
+                        r"passes: a free arc of length $O(\varepsilon^{1/2})$ opens there."),
     )
     table = {}
     for label, b, heading in cases:
         expansion = lindstedt.expand(f"Max(0, u - ({b}))", order=order, a0=1)
         sheet.add_expansion(label, expansion, heading)
 
-        # the truncated omega(eps) = sum_k omega_k eps^k (omega0 = 1) against the exact frequency
+        # the truncated omega(eps) = sum_k omega_k gauge^k (omega0 = 1) against the exact frequency
+        gauge = expansion.gauge
+        truncated = expansion.frequency_expr().subs(OMEGA0, 1)
+        # the first neglected nonzero term, to compare the remainder with
+        next_terms = [expansion.omega_correction(k).subs(OMEGA0, 1) * gauge**k for k in range(len(expansion.omega), len(expansion.omega) + 4)]
+        first_neglected = next((term for term in next_terms if term != 0), sympy.Integer(0))
         rows, worst = [], 0.0
         for epsilon in EPSILONS:
-            exact = references.piecewise_linear_exact_frequency(epsilon, a=1, b=b, a0=1, omega0=1, precision=DIGITS)
-            truncated = sum(omega_k.subs(OMEGA0, 1) * sympy.Rational(epsilon) ** k for k, omega_k in enumerate(expansion.omega))
-            approximate = mpmath.mpf(str(sympy.N(truncated, DIGITS)))
-            difference = exact - approximate
-            rows.append({"epsilon": epsilon, "exact": mpmath.nstr(exact, 20), "expansion": mpmath.nstr(approximate, 20),
-                         "difference": mpmath.nstr(difference, 6)})
-            worst = max(worst, abs(float(difference)))
+            with mpmath.workdps(DIGITS):  # the difference of two 30-digit numbers, taken at 30 digits
+                row, ratio = _compare(epsilon, b, truncated, first_neglected)
+            rows.append(row)
+            worst = max(worst, ratio)
         table[label] = rows
         sheet.paragraph(
             r"Against the exact frequency ($\omega_0 = 1$, exact period of the piecewise-linear oscillator):" + "\n"
@@ -98,12 +107,29 @@ def derive(order: int) -> common.Sheet:
                         worst, EXACT_TOLERANCE,
                         latex=(r"$b = a_{0}$", r"$\omega(\varepsilon)$",
                                r"the exact frequency (closed-form period) at $\varepsilon = 10^{-2}, 10^{-3}, 10^{-4}$"))
+        else:  # asymptotic: the remainder is the first neglected term plus smaller ones
+            sheet.check(label, "|omega_exact - omega_N| / |first neglected term|",
+                        "the exact frequency (closed-form period) at epsilon = 1e-2, 1e-3, 1e-4", worst, REMAINDER_RATIO,
+                        latex=(r"$b = -a_{0}$", r"$|\omega_{\mathrm{exact}} - \omega_{\le N}| / |\text{first neglected term}|$",
+                               r"the exact frequency (closed-form period) at $\varepsilon = 10^{-2}, 10^{-3}, 10^{-4}$"))
     sheet.extra["exact_comparison"] = {
         "omega0": "1",
-        "note": "exact frequency (closed-form period) minus the truncated expansion; b = -a0 shows the non-analytic remainder",
+        "note": "exact frequency (closed-form period) minus the truncated expansion, and the first neglected term",
         "rows": table,
     }
     return sheet
+
+
+def _compare(epsilon: str, b: int, truncated: sympy.Expr, first_neglected: sympy.Expr) -> tuple[dict, float]:
+    """One row of the table and the checked number: |difference| (b = a0) or |difference| / |first neglected term|."""
+    exact = references.piecewise_linear_exact_frequency(epsilon, a=1, b=b, a0=1, omega0=1, precision=DIGITS)
+    value = sympy.Rational(epsilon)
+    approximate = mpmath.mpf(str(sympy.N(truncated.subs(EPSILON, value), DIGITS)))
+    neglected = abs(mpmath.mpf(str(sympy.N(first_neglected.subs(EPSILON, value), DIGITS))))
+    difference = exact - approximate
+    row = {"epsilon": epsilon, "exact": mpmath.nstr(exact, 20), "expansion": mpmath.nstr(approximate, 20),
+           "difference": mpmath.nstr(difference, 6), "first_neglected_term": mpmath.nstr(neglected, 6)}
+    return row, abs(float(difference)) if b == 1 else float(abs(difference) / neglected)
 
 
 if __name__ == "__main__":

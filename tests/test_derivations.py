@@ -165,8 +165,10 @@ def test_derivation_writes_valid_latex_and_json(results, name):
     assert data["schema"] == "lindstedt.derivation/1" and data["name"] == name and data["order"] == result.order
     assert data["omega"] and data["omega"].keys() == data["omega_float"].keys()
     expected_length = 2 if name == "all_modes" else result.order + 1
-    for values in data["omega"].values():
-        assert len(values) == expected_length and all(isinstance(value, str) for value in values)
+    for label, values in data["omega"].items():
+        # the grazing case b = -a0 is expanded in powers of eps^(1/2): 2N + 1 coefficients
+        length = 2 * result.order + 1 if (name, label) == ("grazing", "b = -a0") else expected_length
+        assert len(values) == length and all(isinstance(value, str) for value in values)
     assert all(check["agrees"] for check in data["checks"]), data["checks"]
 
 
@@ -232,18 +234,26 @@ def test_negative_release_shares_omega_1_with_the_positive_release_only(results)
     assert differences[0] == 0 and abs(differences[1]) < 1e-25 and abs(differences[2]) > 1e-3
 
 
-def test_grazing_flags_the_regime_and_reduces_to_the_linear_approximation(results):
+def test_grazing_flags_the_regime_and_expands_in_the_right_gauge(results):
     data = results["grazing"].json
     for variant in data["variants"]:
         assert variant["regime"] == "grazing"
-        assert variant["validity"]["exponent"] == "-1/2"
-        assert variant["contact_angles"] == []
+    touching, passing = data["variants"]
+    assert touching["validity"]["exponent"] == "-1/2" and touching["contact_angles"] == []
     assert data["omega"]["b = a0"] == ["omega0", "0", "0"]
+    assert {row["difference"] for row in data["exact_comparison"]["rows"]["b = a0"]} == {"0.0"}
+    # b = -a0: gauge eps^(1/2), the free arc opens at the far turning point
+    assert passing["expansion"]["gauge"] == "sqrt(epsilon)" and passing["contact_angles"] == ["pi"]
+    # even powers: the Taylor series of the contact side sqrt(omega0^2 + eps), which the O(eps^(1/2)) free arc
+    # changes only from eps^(5/2) on (order 2 stops at eps^2)
     linear = sympy.series(sympy.sqrt(OMEGA0**2 + EPSILON), EPSILON, 0, 3).removeO()
     for k, text in enumerate(data["omega"]["b = -a0"]):
-        assert sympy.simplify(parse(text) - linear.coeff(EPSILON, k)) == 0
-    assert {row["difference"] for row in data["exact_comparison"]["rows"]["b = a0"]} == {"0.0"}
-    assert r"\varepsilon^{-1/2}" in results["grazing"].latex
+        expected = linear.coeff(EPSILON, k // 2) if k % 2 == 0 else 0
+        assert sympy.simplify(parse(text) - expected) == 0, k
+    for row in data["exact_comparison"]["rows"]["b = -a0"]:
+        ratio = abs(float(row["difference"])) / float(row["first_neglected_term"])
+        assert 0.5 < ratio < 2, row  # the remainder is the first neglected term (-8/(3 pi) eps^(5/2)) and less
+    assert r"\varepsilon^{-1/2}" in results["grazing"].latex and r"\varepsilon^{\frac{5}{2}}" in results["grazing"].latex
 
 
 def test_nnm_2dof_every_mode_against_closed_forms(results):

@@ -60,11 +60,24 @@ class ContactState:
 
 @dataclass(frozen=True)
 class MovingBoundary:
-    """A contact angle β = arccos κ where ``Σ_k coupling[k] W_k`` crosses κ (``sine`` = sin β ≠ 0)."""
+    """A contact angle β = arccos κ where ``Σ_k coupling[k] W_k`` crosses κ.
+
+    A simple crossing has ``sine`` = sin β ≠ 0 and moves as ``s* = β + Σ σ_n η^n``.  A
+    *grazing* boundary sits at a turning point (β = 0 or π, sine 0): the gap has a double
+    root there, the crossing exists only because the order-one orbit moves past the
+    breakpoint, and its shift starts at ``first_shift`` = σ_1 in the gauge η = ε̂^{1/2}
+    (root of the quadratic contact condition, chosen by the normal form).
+    """
 
     point: EvaluationPoint
     coupling: tuple[Any, ...]
     sine: Any
+    first_shift: Any = None
+
+    @property
+    def grazing(self) -> bool:
+        """True for a boundary at a turning point (double root of the order-zero gap)."""
+        return self.first_shift is not None
 
 
 @dataclass(frozen=True)
@@ -74,7 +87,9 @@ class BranchSystem:
     ``ratios[k] = r_k`` (``None`` for the mode component j, whose frequency is 1
     and whose solves use the exact rational kernel); ``states`` has one entry per
     piece of [0, π], ``boundaries`` one per crossing, increasing in angle;
-    ``release`` is ``w_1``, the order-1 value of W_j(0) under the "initial" normalisation.
+    ``release`` is ``w_1``, the ε̂-coefficient of W_j(0) under the "initial" normalisation.
+    ``gauge`` is 1 for expansions in η = ε̂ and 2 for η = ε̂^{1/2} (a grazing boundary is
+    crossed): the laws and the release then enter at order 2 in η.
     """
 
     domain: Any
@@ -85,6 +100,7 @@ class BranchSystem:
     zero_point: EvaluationPoint
     pi_point: EvaluationPoint
     release: Any
+    gauge: int = 1
 
     @property
     def size(self) -> int:
@@ -262,7 +278,12 @@ class BranchHierarchy(LazyOrders):
         ]
         self._squared: list[Any] = [domain.one]
         self._frequencies: list[Any] = [domain.one]
-        self._shifts: list[list[Any]] = [[boundary.point.value for boundary in system.boundaries]]
+        # per boundary: [β, σ_1, σ_2, …] as far as known (a grazing boundary starts with its σ_1
+        # and learns σ_{n−1} at order n, from the contact condition where σ_{n−1} first appears)
+        self._shifts: list[list[Any]] = [
+            [boundary.point.value] + ([boundary.first_shift] if boundary.grazing else []) for boundary in system.boundaries
+        ]
+        self._lag = int(any(boundary.grazing for boundary in system.boundaries))
         self._derivatives: dict[tuple[int, int, int, int], Branch] = {}
         self._resonant = Branch(domain, {(1, 1, 1): domain.one / domain.convert(2)})  # s sin s / 2 solves v'' + v = cos s
         self.counters = {"orders": 0}
@@ -275,8 +296,8 @@ class BranchHierarchy(LazyOrders):
 
     def boundary_shift(self, order: int) -> list[Any]:
         """σ_{i,order} for every boundary (order 0: the contact angles β_i)."""
-        self._ensure(order)
-        return self._shifts[order]
+        self._ensure(order + self._lag)
+        return [shifts[order] for shifts in self._shifts]
 
     def release(self, order: int, component: int) -> Any:
         """W_{order, component}(0)."""
@@ -297,6 +318,7 @@ class BranchHierarchy(LazyOrders):
             )
             for n in range(highest + 1)
         )
+        self._ensure(highest + self._lag)
         shifts = tuple(tuple(to_float(value) for value in self.boundary_shift(n)) for n in range(highest + 1))
         return FloatBranches(terms, shifts)
 
@@ -311,8 +333,8 @@ class BranchHierarchy(LazyOrders):
         return self._derivatives[key]
 
     def _shift_powers(self, boundary: int, order: int) -> list[list[Any]]:
-        """[δσ^n]_j for n, j <= order, δσ = Σ_{1<=i<order} σ_i ε̂^i (σ_order excluded)."""
-        return shift_powers([terms[boundary] for terms in self._shifts[:order]], order, self._domain)
+        """[δσ^n]_j for n, j <= order, δσ = Σ_i σ_i η^i over the σ_i known before order ``order``."""
+        return shift_powers(self._shifts[boundary][:order], order, self._domain)
 
     def _known(self, boundary: int, piece: int, component: int, order: int, derivative: int, powers: list[list[Any]]) -> Any:
         """ε̂^order coefficient of ∂^derivative W_component^piece at s*(ε̂), without W_order and σ_order."""
@@ -368,9 +390,9 @@ class BranchHierarchy(LazyOrders):
                 for i in range(1, order):
                     rhs = rhs - self._derivative(order - i, piece, k, 2).scale(self._squared[i])
                 for l, entry in enumerate(state.stiffness[k]):
-                    if entry:
-                        rhs = rhs - self._branches[order - 1][piece][l].scale(entry)
-                if order == 1 and state.load[k]:
+                    if entry and order >= system.gauge:
+                        rhs = rhs - self._branches[order - system.gauge][piece][l].scale(entry)
+                if order == system.gauge and state.load[k]:
                     rhs = rhs - Branch.constant(domain, state.load[k])
                 components.append(rhs.oscillator_particular_solution(system.ratios[k]))
             particular.append(components)
@@ -408,7 +430,15 @@ class BranchHierarchy(LazyOrders):
                 if coupling:
                     value = value_of(left, k, c_values[left][k], d_values[left][k], point, False)
                     gap = gap + value.shift(self._known(index, left, k, order, 0, powers)).scale(coupling)
-            shift_values.append(gap.scale(one / (boundary.coupling[mode] * boundary.sine)))
+            if not boundary.grazing:
+                shift_values.append(gap.scale(one / (boundary.coupling[mode] * boundary.sine)))
+            elif order >= 3:
+                # σ_{n−1} first appears here, through c_j W_0''(β) σ_1 σ_{n−1} (W_0'' = −cos β = −κ_j);
+                # σ_1 came from the order-2 quadratic, solved by the normal form.
+                curvature = -point.cos_multiple(1)
+                shift_values.append(gap.scale(-one / (boundary.coupling[mode] * curvature * boundary.first_shift)))
+            else:
+                shift_values.append(None)
             # C¹ matching of every component: the homogeneous parts of the right piece.
             c_next, d_next = [], []
             for k in range(size):
@@ -429,7 +459,7 @@ class BranchHierarchy(LazyOrders):
         equations = [value_of(last, k, c_values[last][k], d_values[last][k], system.pi_point, True) for k in range(size)]
         if self.normalization == "initial":
             release = value_of(0, mode, c_values[0][mode], d_values[0][mode], system.zero_point, False)
-            equations.append(release.shift(-system.release) if order == 1 else release)
+            equations.append(release.shift(-system.release) if order == system.gauge else release)
         else:
             equations.append(self._first_harmonic_condition(order, particular, c_values, d_values, unit(0)))
         unknowns = solve_linear([list(e.coefficients) for e in equations], [-e.base for e in equations], domain, order)
@@ -449,7 +479,9 @@ class BranchHierarchy(LazyOrders):
             branches.append(components)
         self._branches.append(branches)
         self._squared.append(unknowns[0])
-        self._shifts.append([value.value(unknowns) for value in shift_values])
+        for shifts, value in zip(self._shifts, shift_values):
+            if value is not None:
+                shifts.append(value.value(unknowns))
         self.counters["orders"] += 1
 
     def _first_harmonic_condition(self, order: int, particular: list, c_values: list, d_values: list, resonant_unit: _Affine) -> _Affine:

@@ -34,7 +34,7 @@ from .._errors import ProblemError
 from ..problems.piecewise_linear import decompose_piecewise_linear
 from ..problems.oscillator import DISPLACEMENT, Oscillator
 from ..algebra.branch import EvaluationPoint
-from .branches import BranchSystem, ContactState, MovingBoundary
+from .branches import BranchHierarchy, BranchSystem, ContactState, MovingBoundary
 
 __all__ = ["ContactBoundary", "PiecewiseNormalForm", "contact_normal_form"]
 
@@ -70,6 +70,7 @@ class PiecewiseNormalForm:
     # (|κ| = 1), "above" (κ > 1: never reached) or "below" (κ < -1: permanent contact).
     amplitude_sign: int = 1
     breakpoint_classes: tuple[tuple[sympy.Expr, str], ...] = ()
+    gauge: int = 1  # 1: series in ε; 2: in ε^{1/2} (the perturbed orbit crosses a grazing breakpoint)
 
     def to_expr(self, element: Any) -> sympy.Expr:
         """Domain element -> sympy expression with generators substituted."""
@@ -79,8 +80,8 @@ class PiecewiseNormalForm:
         return expression
 
     def scaled_expr(self, element: Any, power: int, prefactor: sympy.Expr) -> sympy.Expr:
-        """``prefactor · (1/ω0²)^power · element`` in the problem's symbols."""
-        return prefactor * self.epsilon_scale**power * self.to_expr(element)
+        """``prefactor · (1/ω0²)^(power/gauge) · element`` in the problem's symbols (η^power = (ε/ω0²)^(power/gauge))."""
+        return prefactor * self.epsilon_scale ** sympy.Rational(power, self.gauge) * self.to_expr(element)
 
 
 class _ConstantField:
@@ -237,12 +238,54 @@ def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hi
     for index in reversed(crossing):
         current = index  # crossing κ_index moves from interval index+1 down to index
         interval_of.append(current)
+    form = _assemble(problem, w_intervals, interval_of, crossing_kappas, (), grazing, classes, sign, digits, order_hint)
+    crossed = []
+    for kappa in grazing:
+        # The orbit's turning point w0 = κ = ±1 touches the breakpoint: does the order-one orbit pass it?
+        # The gap W − κ near β has the double root of W_0 plus ε̂ W_1(β): with η = ε̂^{1/2} and s* = β + σ_1 η + …,
+        # W_1(β) + W_0''(β) σ_1²/2 = 0, W_0''(β) = −κ, so σ_1² = 2 W_1(β)/κ: a real crossing iff σ_1² > 0.
+        top = kappa > 0
+        hierarchy = BranchHierarchy(form.system, problem.normalization)
+        piece = 0 if top else len(form.system.states) - 1
+        point = form.system.zero_point if top else form.system.pi_point
+        squared = 2 * form.to_expr(hierarchy.branches(1)[piece][0].evaluate(point)) / kappa
+        if squared.is_positive:
+            interval = kappas.index(kappa) + (1 if top else 0)
+            crossed.append((kappa, interval, (1 if top else -1) * sympy.sqrt(squared)))
+        elif squared.is_positive is None and not squared.is_zero and not squared.is_negative:
+            raise ProblemError(
+                f"grazing at kappa = {kappa}: cannot decide whether the perturbed orbit crosses the breakpoint "
+                f"(sigma_1^2 = {squared}); give numeric values for the parameters"
+            )
+    if crossed:
+        form = _assemble(problem, w_intervals, interval_of, crossing_kappas, tuple(crossed), grazing, classes, sign, digits, order_hint)
+    return form
+
+
+def _assemble(
+    problem: Oscillator,
+    w_intervals: list,
+    interval_of: list[int],
+    crossing_kappas: list[sympy.Expr],
+    crossed: tuple,
+    grazing: list[sympy.Expr],
+    classes: list,
+    sign: int,
+    digits: int | None,
+    order_hint: int,
+) -> PiecewiseNormalForm:
+    """The normal form with its coefficient field; ``crossed`` lists the grazing breakpoints
+    (κ, interval beyond, σ_1) that the perturbed orbit passes (gauge η = ε̂^{1/2})."""
+    top = [item for item in crossed if item[0] > 0]
+    bottom = [item for item in crossed if item[0] < 0]
+    interval_of = [item[1] for item in top] + list(interval_of) + [item[1] for item in bottom]
     values: list[sympy.Expr] = []
     for interval_index in interval_of:
         _, _, slope, intercept = w_intervals[interval_index]
         values += [slope, intercept]
     for kappa in crossing_kappas:
         values += [kappa, sympy.acos(kappa), _contact_sine(kappa)]
+    values += [item[2] for item in crossed]
     numeric = digits is not None or any(value.has(sympy.Float) for value in values)
     if numeric:
         digits = (digits or 30) + _guard_digits(crossing_kappas, order_hint)
@@ -252,24 +295,33 @@ def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hi
     for interval_index in interval_of:
         _, _, slope, intercept = w_intervals[interval_index]
         piece_coefficients.append((field.convert(slope), field.convert(intercept)))
-    boundaries = []
+    zero = EvaluationPoint(domain, domain.zero, domain.one, domain.zero)
+    pi_point = EvaluationPoint(domain, field.convert(sympy.pi), -domain.one, domain.zero)
+    boundaries, moving = [], []
+    for kappa, _, first_shift in top:
+        boundaries.append(ContactBoundary(kappa, sympy.Integer(0), zero, domain.one, domain.zero))
+        moving.append(MovingBoundary(zero, (domain.one,), domain.zero, field.convert(first_shift)))
     for kappa in sorted(crossing_kappas, key=lambda k: -k if k.is_number else 0):
         angle = sympy.acos(kappa)
         kappa_element = field.convert(kappa)
         sine_element = field.convert(_contact_sine(kappa))
         point = EvaluationPoint(domain, field.convert(angle), kappa_element, sine_element)
         boundaries.append(ContactBoundary(kappa, angle, point, kappa_element, sine_element))
-    zero = EvaluationPoint(domain, domain.zero, domain.one, domain.zero)
-    pi_point = EvaluationPoint(domain, field.convert(sympy.pi), -domain.one, domain.zero)
+        moving.append(MovingBoundary(point, (domain.one,), sine_element))
+    for kappa, _, first_shift in bottom:
+        boundaries.append(ContactBoundary(kappa, sympy.pi, pi_point, -domain.one, domain.zero))
+        moving.append(MovingBoundary(pi_point, (domain.one,), domain.zero, field.convert(first_shift)))
+    gauge = 2 if crossed else 1
     system = BranchSystem(
         domain=domain,
         ratios=(None,),
         mode=0,
         states=tuple(ContactState(((slope,),), (intercept,)) for slope, intercept in piece_coefficients),
-        boundaries=tuple(MovingBoundary(b.point, (domain.one,), b.sine_element) for b in boundaries),
+        boundaries=tuple(moving),
         zero_point=zero,
         pi_point=pi_point,
         release=domain.zero,
+        gauge=gauge,
     )
     if grazing:
         regime = "grazing"
@@ -277,7 +329,9 @@ def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hi
         regime = "no contact"
     else:
         regime = "contact"
-    validity = sympy.Rational(-1, 2) if grazing else sympy.Integer(-1)
+    # The expansion in η = ε̂^{1/2} past a crossed grazing point holds on t ≲ 1/ε like the analytic one; a
+    # grazing breakpoint that the orbit only touches keeps the linear-approximation time scale ε^{-1/2}.
+    validity = sympy.Rational(-1, 2) if grazing and not crossed else sympy.Integer(-1)
     return PiecewiseNormalForm(
         domain=domain,
         epsilon_scale=1 / problem.omega0**2,
@@ -291,4 +345,5 @@ def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hi
         prune_tolerance=None if not field.numeric else 0.0,
         amplitude_sign=sign,
         breakpoint_classes=tuple(classes),
+        gauge=gauge,
     )

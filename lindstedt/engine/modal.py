@@ -35,7 +35,7 @@ from sympy import RealField
 from .._errors import ProblemError, ResonanceError
 from ..problems.system import UnilateralSystem
 from ..algebra.branch import EvaluationPoint
-from .branches import BranchSystem, ContactState, MovingBoundary
+from .branches import BranchHierarchy, BranchSystem, ContactState, MovingBoundary
 
 __all__ = ["ModalNormalForm", "SpringAtOrderZero", "modal_guard_digits", "modal_normal_form"]
 
@@ -52,6 +52,11 @@ class SpringAtOrderZero:
     kappa: Any | None
     orientation: int  # +1: contact for cos s > κ (near s = 0); -1: contact for cos s < κ
     status: str  # "crossing", "grazing", "never", "always"
+
+    @property
+    def touches_from_contact(self) -> bool:
+        """A grazing spring in contact over the rest of the orbit (it touches its gap at one turning point)."""
+        return self.status == "grazing" and (self.kappa > 0) != (self.orientation > 0)
 
 
 @dataclass(frozen=True)
@@ -143,38 +148,78 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
     B = [[sum((A[i][row] * shapes[k][row] for row in range(size)), domain.zero) for k in range(size)] for i in range(springs_count)]
     G = [[sum((shapes[k][row] * W[row][i] for row in range(size)), domain.zero) for i in range(springs_count)] for k in range(size)]
     springs = tuple(_classify(i, a0 * B[i][mode], gaps[i], digits, mode) for i in range(springs_count))
-    # Moving boundaries, increasing in angle.
-    boundaries, angles = [], []
-    for spring in sorted((s for s in springs if s.status == "crossing"), key=lambda s: s.kappa.context.acos(s.kappa)):
-        kappa = spring.kappa
-        angle = kappa.context.acos(kappa)
-        point = EvaluationPoint(domain, angle, kappa, kappa.context.sqrt((1 - kappa) * (1 + kappa)))
-        coupling = tuple(a0 * B[spring.index][k] for k in range(size))
-        boundaries.append((spring, MovingBoundary(point, coupling, point.sin_multiple(1))))
-        angles.append(angle)
     pi = domain.convert(sympy.N(sympy.pi, digits + 10))
-    # One contact state per piece: a sample angle inside it decides the active springs.
-    limits = [domain.zero] + angles + [pi]
-    states = []
-    for lower, upper in zip(limits, limits[1:]):
-        middle = (lower + upper) / 2
-        cosine = middle.context.cos(middle)
-        active = [
-            s.index
-            for s in springs
-            if s.status == "always" or (s.status == "crossing" and ((cosine > s.kappa) if s.orientation > 0 else (cosine < s.kappa)))
-        ]
-        stiffness = tuple(tuple(sum((G[k][i] * B[i][l] for i in active), domain.zero) for l in range(size)) for k in range(size))
-        load = tuple(-sum((G[k][i] * gaps[i] for i in active), domain.zero) / a0 for k in range(size))
-        states.append(ContactState(stiffness, load))
-    branch_system = BranchSystem(
-        domain=domain,
-        ratios=tuple(None if k == mode else ratio for k, ratio in enumerate(ratios)),
-        mode=mode,
-        states=tuple(states),
-        boundaries=tuple(boundary for _, boundary in boundaries),
-        zero_point=EvaluationPoint(domain, domain.zero, domain.one, domain.zero),
-        pi_point=EvaluationPoint(domain, pi, -domain.one, domain.zero),
-        release=convert(release_correction) * lam * lam / a0,
-    )
+    zero_point = EvaluationPoint(domain, domain.zero, domain.one, domain.zero)
+    pi_point = EvaluationPoint(domain, pi, -domain.one, domain.zero)
+
+    def assemble(crossed: dict[int, Any]) -> BranchSystem:
+        """The branch system; ``crossed`` maps a grazing spring the perturbed orbit passes to its σ_1."""
+        top = [s for s in springs if s.index in crossed and s.kappa > 0]
+        bottom = [s for s in springs if s.index in crossed and s.kappa < 0]
+        crossing = sorted((s for s in springs if s.status == "crossing"), key=lambda s: s.kappa.context.acos(s.kappa))
+        boundaries, angles = [], []
+        for spring in top:
+            boundaries.append(MovingBoundary(zero_point, tuple(a0 * B[spring.index][k] for k in range(size)), domain.zero, crossed[spring.index]))
+        for spring in crossing:
+            kappa = spring.kappa
+            angle = kappa.context.acos(kappa)
+            point = EvaluationPoint(domain, angle, kappa, kappa.context.sqrt((1 - kappa) * (1 + kappa)))
+            boundaries.append(MovingBoundary(point, tuple(a0 * B[spring.index][k] for k in range(size)), point.sin_multiple(1)))
+            angles.append(angle)
+        for spring in bottom:
+            boundaries.append(MovingBoundary(pi_point, tuple(a0 * B[spring.index][k] for k in range(size)), domain.zero, crossed[spring.index]))
+        # One contact state per piece: a sample angle inside it decides the active springs (a crossed
+        # grazing spring flips on its short piece next to the turning point).
+        limits = [domain.zero] + angles + [pi]
+        samples = [(lower + upper) / 2 for lower, upper in zip(limits, limits[1:])]
+        flipped = [set() for _ in samples]
+        if top:
+            samples.insert(0, domain.zero)
+            flipped.insert(0, {s.index for s in top})
+        if bottom:
+            samples.append(pi)
+            flipped.append({s.index for s in bottom})
+        states = []
+        for middle, flips in zip(samples, flipped):
+            cosine = middle.context.cos(middle)
+            active = [
+                s.index
+                for s in springs
+                if (s.status == "always" or s.touches_from_contact or (s.status == "crossing" and ((cosine > s.kappa) if s.orientation > 0 else (cosine < s.kappa))))
+                != (s.index in flips)
+            ]
+            stiffness = tuple(tuple(sum((G[k][i] * B[i][l] for i in active), domain.zero) for l in range(size)) for k in range(size))
+            load = tuple(-sum((G[k][i] * gaps[i] for i in active), domain.zero) / a0 for k in range(size))
+            states.append(ContactState(stiffness, load))
+        return BranchSystem(
+            domain=domain,
+            ratios=tuple(None if k == mode else ratio for k, ratio in enumerate(ratios)),
+            mode=mode,
+            states=tuple(states),
+            boundaries=tuple(boundaries),
+            zero_point=zero_point,
+            pi_point=pi_point,
+            release=convert(release_correction) * lam * lam / a0,
+            gauge=2 if crossed else 1,
+        )
+
+    branch_system = assemble({})
+    crossed = {}
+    grazing = [s for s in springs if s.status == "grazing"]
+    if grazing:
+        # A grazing spring touches its gap at a turning point β (double root of the order-zero gap).  The
+        # order-one orbit decides: with η = ε̂^{1/2}, s* = β + σ_1 η, the gap's ε̂ term g_1 = Σ_k c_k W_{1,k}(β)
+        # and W_0''(β) = −cos β give g_1 − c_j cos β σ_1²/2 = 0; the perturbed orbit passes iff σ_1² > 0.
+        first_order = BranchHierarchy(branch_system).branches(1)
+        for spring in grazing:
+            top = spring.kappa > 0
+            point, piece = (zero_point, 0) if top else (pi_point, len(branch_system.states) - 1)
+            coupling = [a0 * B[spring.index][k] for k in range(size)]
+            gap = sum((coupling[k] * first_order[piece][k].evaluate(point) for k in range(size)), domain.zero)
+            squared = 2 * gap / (coupling[mode] * point.cos_multiple(1))
+            if squared > mpmath.mpf(10) ** (-digits // 2) * max(1, abs(gap)):
+                root = squared.context.sqrt(squared)
+                crossed[spring.index] = root if top else -root
+        if crossed:
+            branch_system = assemble(crossed)
     return ModalNormalForm(branch_system, digits, tuple(frequencies), a0, springs, small_divisors)

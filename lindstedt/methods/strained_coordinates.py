@@ -52,12 +52,15 @@ class StrainedCoordinatesNNM:
         digits = self.precision + modal_guard_digits(system, mode - 1, order)
         form = modal_normal_form(system, mode - 1, problem.a0, problem.a1, digits)
         hierarchy = BranchHierarchy(form.system)
+        steps = form.system.gauge  # η = ε̂ or ε̂^{1/2} (a grazing spring that the perturbed orbit passes)
         lam = form.frequencies[mode - 1]
-        scale = 1 / (lam * lam)
-        omegas = tuple(hierarchy.frequency(n) * lam * scale**n for n in range(order + 1))
-        alphas = tuple(hierarchy.squared_frequency(n) * lam * lam * scale**n for n in range(order + 1))
+        root = lam ** (-2 / form.system.domain.convert(steps))  # (1/λ²)^(1/steps): η = root · ε^(1/steps)
+        omegas = tuple(hierarchy.frequency(n) * lam * root**n for n in range(steps * order + 1))
+        alphas = tuple(hierarchy.squared_frequency(n) * lam * lam * root**n for n in range(steps * order + 1))
         zero = form.system.domain.zero
-        releases = tuple(hierarchy.release(1, k) * form.amplitude * scale if order >= 1 else zero for k in range(system.n_dof))
+        releases = tuple(
+            hierarchy.release(steps, k) * form.amplitude * root**steps if order >= 1 else zero for k in range(system.n_dof)
+        )
         roots = tuple({"crossing": "simple", "grazing": "double"}.get(spring.status, "none") for spring in form.springs)
         return NNMExpansion(
             problem=problem,
@@ -67,8 +70,11 @@ class StrainedCoordinatesNNM:
             omega=omegas,
             alpha=alphas,
             release_modal=releases,
-            validity_exponent=sympy.Rational(-1, 2) if "double" in roots else sympy.Integer(-1),
+            # a grazing spring the perturbed orbit passes is expanded in the gauge ε^{1/2} (valid on t ≲ 1/ε);
+            # one it only touches keeps the linear-approximation time scale ε^{-1/2}
+            validity_exponent=sympy.Rational(-1, 2) if "double" in roots and steps == 1 else sympy.Integer(-1),
             spring_roots=roots,
+            gauge=steps,
             small_divisors=tuple((k + 1, n, float(d)) for k, n, d in form.small_divisors),
             _hierarchy=hierarchy,
         )

@@ -19,7 +19,9 @@ JSON schema ``lindstedt.expansion/1`` (:meth:`Expansion.to_dict`)::
       "problem": {"equation": str, "f": str, "a0": str, "omega0": str,
                   "parameters": {name: str}, "normalization": str},
       "order": int, "normalization": "initial" | "harmonic",
-      "omega": [str, ...],            # ω_0..ω_N, sympy-parsable
+      "gauge": "epsilon" | "sqrt(epsilon)",    # ω(ε) = Σ_k ω_k gauge^k
+      "exponents": [str, ...],        # the power of ε of each ω_k: k, or k/2
+      "omega": [str, ...],            # ω_0..ω_N (ω_0..ω_2N in the gauge ε^(1/2)), sympy-parsable
       "omega_float": [float | null],  # null where symbolic
       "alpha": [str, ...], "alpha_float": [float | null],
       "omega_next": str,              # ω_{N+1}, used by the displacement evaluator
@@ -236,6 +238,34 @@ class Expansion:
         return self._form.validity_exponent
 
     @property
+    def gauge(self) -> sympy.Expr:
+        """The expansion variable: ``epsilon``, or ``sqrt(epsilon)`` when the perturbed orbit crosses a
+        breakpoint that the unperturbed orbit only touches (grazing: ω(ε) is not analytic at 0).
+
+        Every sequence of coefficients (``omega``, ``alpha``, ``waveforms``, the index of
+        :meth:`omega_correction`) runs over the powers of the gauge: ω(ε) = Σ_k ω_k gauge^k,
+        k = 0 … gauge-order of ε^N (2N for ``sqrt(epsilon)``).
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> e = lindstedt.expand("Max(0, u + 1)", order=3, a0=1, omega0=1)   # grazing at the far turning point
+        >>> e.gauge, e.omega[5]
+        (sqrt(epsilon), -8/(3*pi))
+        """
+        return EPSILON if self._steps == 1 else EPSILON ** sympy.Rational(1, self._steps)
+
+    @property
+    def _steps(self) -> int:
+        """Powers of the gauge per power of ε (1, or 2 for the gauge ε^{1/2})."""
+        return getattr(self._form, "gauge", 1)
+
+    @property
+    def exponents(self) -> tuple[sympy.Rational, ...]:
+        """The power of ε of each entry of ``omega`` (k/2 in the gauge sqrt(epsilon))."""
+        return tuple(sympy.Rational(k, self._steps) for k in range(self._steps * self.order + 1))
+
+    @property
     def contact_angles(self) -> tuple[sympy.Expr, ...]:
         """β_i = arccos κ_i of the contact boundaries crossed by v_0 (empty for smooth f)."""
         return tuple(boundary.contact_angle for boundary in self._form.boundaries)
@@ -252,8 +282,9 @@ class Expansion:
         return self._form.scaled_expr(element, power, prefactor)
 
     def _check(self, order: int) -> None:
-        if isinstance(order, bool) or not isinstance(order, int) or order < 0 or order > MAX_ORDER + 1:
-            raise OrderError(f"correction index must be an integer in [0, {MAX_ORDER + 1}], got {order!r}")
+        highest = self._steps * (MAX_ORDER + 1)
+        if isinstance(order, bool) or not isinstance(order, int) or order < 0 or order > highest:
+            raise OrderError(f"correction index must be an integer in [0, {highest}], got {order!r}")
 
     def omega_correction(self, order: int) -> sympy.Expr:
         """Exact ω_order (any order, computed lazily; beyond ``self.order`` allowed)."""
@@ -291,22 +322,22 @@ class Expansion:
     @cached_property
     def omega(self) -> tuple[sympy.Expr, ...]:
         """(ω_0, …, ω_N), exact."""
-        return tuple(self.omega_correction(k) for k in range(self.order + 1))
+        return tuple(self.omega_correction(k) for k in range(self._steps * self.order + 1))
 
     @cached_property
     def alpha(self) -> tuple[sympy.Expr, ...]:
         """(α_0, …, α_N) with ω² = Σ α_k ε^k, exact."""
-        return tuple(self.alpha_correction(k) for k in range(self.order + 1))
+        return tuple(self.alpha_correction(k) for k in range(self._steps * self.order + 1))
 
     @cached_property
     def waveforms(self) -> tuple[Waveform | PiecewiseWaveform, ...]:
         """(v_0, …, v_N), exact cosine polynomials."""
-        return tuple(self.waveform(k) for k in range(self.order + 1))
+        return tuple(self.waveform(k) for k in range(self._steps * self.order + 1))
 
     @cached_property
     def omega_next(self) -> sympy.Expr:
         """ω_{N+1}: the frequency term the displacement evaluator pairs with v_0..v_N."""
-        return self.omega_correction(self.order + 1)
+        return self.omega_correction(self._steps * self.order + 1)
 
     # -- numeric evaluation ---------------------------------------------------------------
     def _substitution(self, values: Mapping[Any, Any] | None) -> dict[sympy.Symbol, sympy.Expr]:
@@ -338,17 +369,18 @@ class Expansion:
         order : int, optional
             Truncation order (default: the expansion's order).
         """
-        order = self.order if order is None else order
-        coefficients = self._frequency_coefficients(order + 1, values)
-        points = np.asarray(epsilon, dtype=float)
-        result = np.polynomial.polynomial.polyval(points, coefficients[: order + 1])
-        if order >= 1:
-            next_term = np.abs(coefficients[order + 1] * points ** (order + 1))
+        last = self._steps * (self.order if order is None else order)
+        coefficients = self._frequency_coefficients(last + 1, values)
+        points = self._gauge_values(epsilon)
+        result = np.polynomial.polynomial.polyval(points, coefficients[: last + 1])
+        if last >= 1:
+            next_term = np.abs(coefficients[last + 1] * points ** (last + 1))
             correction = np.abs(result - coefficients[0])
             if np.any(next_term > np.maximum(correction, 1e-300)):
                 warnings.warn(
                     ExpansionValidityWarning(
-                        f"at eps = {np.max(np.abs(points)):.3g} the next term omega_{order + 1} eps^{order + 1} is larger than "
+                        f"at eps = {np.max(np.abs(np.asarray(epsilon, dtype=float))):.3g} the next term "
+                        f"omega_{last + 1} {self.gauge}^{last + 1} is larger than "
                         "the whole correction: the series is not converging there; use a smaller eps or a numerical "
                         "method (lindstedt.reference_solution, lindstedt.nnm_point)"
                     ),
@@ -366,10 +398,22 @@ class Expansion:
         >>> round(float(e.truncation_error_estimate(0.1)), 12)     # |omega_2| eps^2 = 21/256 * 0.01
         0.0008203125
         """
-        order = self.order if order is None else order
-        coefficient = self._frequency_coefficients(order + 1, values)[order + 1]
+        last = self._steps * (self.order if order is None else order)
+        coefficient = self._frequency_coefficients(last + 1, values)[last + 1]
+        return np.abs(coefficient * self._gauge_values(epsilon) ** (last + 1))
+
+    def _gauge_values(self, epsilon: Any) -> np.ndarray:
+        """The gauge at ε (ε itself, or √ε: then ε must not be negative)."""
         points = np.asarray(epsilon, dtype=float)
-        return np.abs(coefficient * points ** (order + 1))
+        if self._steps == 1:
+            return points
+        if np.any(points < 0):
+            raise ParameterError(
+                "this expansion is in powers of sqrt(epsilon): it holds for epsilon >= 0, where the perturbed orbit "
+                "crosses the grazing breakpoint; for epsilon < 0 the orbit stays on its side and the frequency is "
+                "analytic (use lindstedt.reference_solution, or expand the problem with f replaced by -f for -epsilon)"
+            )
+        return np.sqrt(points)
 
     @cached_property
     def _float_cache(self) -> dict[Any, Any]:
@@ -404,7 +448,7 @@ class Expansion:
             def to_float(element: Any) -> float:
                 return _to_float(form.to_expr(element).xreplace(substitution))
 
-            branches = self._hierarchy.float_branches(self.order, to_float)
+            branches = self._hierarchy.float_branches(self._steps * self.order, to_float)
             numbers = [term[3] for order in branches.terms for piece in order for component in piece for term in component]
             _finite(np.array(numbers + [value for order in branches.shifts for value in order], dtype=float), substitution)
             scale = float(form.epsilon_scale.xreplace(substitution))
@@ -414,9 +458,11 @@ class Expansion:
 
     def _evaluate(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None, derivative: bool) -> Any:
         scale, amplitude, branches = self._float_branches(values)
-        frequency = float(np.polynomial.polynomial.polyval(float(epsilon), self._frequency_coefficients(self.order + 1, values)))
+        gauge = float(self._gauge_values(float(epsilon)))
+        coefficients = self._frequency_coefficients(self._steps * self.order + 1, values)
+        frequency = float(np.polynomial.polynomial.polyval(gauge, coefficients))
         strained = np.asarray(t, dtype=float) * frequency
-        result = amplitude * branches.evaluate(strained, scale * float(epsilon), derivative)[..., 0]
+        result = amplitude * branches.evaluate(strained, scale ** (1 / self._steps) * gauge, derivative)[..., 0]
         if derivative:
             result = result * frequency
         return result if result.ndim else float(result)
@@ -443,8 +489,8 @@ class Expansion:
     # -- symbolic views and exports -------------------------------------------------------
     def frequency_expr(self, order: int | None = None) -> sympy.Expr:
         """ω(ε) truncated at ``order`` as a sympy polynomial in ``epsilon``."""
-        order = self.order if order is None else order
-        return sympy.Add(*[self.omega_correction(k) * EPSILON**k for k in range(order + 1)])
+        last = self._steps * (self.order if order is None else order)
+        return sympy.Add(*[self.omega_correction(k) * self.gauge**k for k in range(last + 1)])
 
     def displacement_expr(self) -> sympy.Expr:
         """u(t; ε) = Σ_{k≤N} ε^k v_k(ω t) with ω through ω_{N+1}, as a sympy expression.
@@ -453,13 +499,13 @@ class Expansion:
         (evenness, 2π-periodicity) and the pieces end at the moving contact
         angles s_i*(ε) = β_i + Σ_{k≤N} σ_{i,k} ε^k, as in :meth:`displacement`.
         """
-        frequency = self.frequency_expr(self.order + 1)
+        frequency = self.frequency_expr(self.order) + self.omega_next * self.gauge ** (self._steps * self.order + 1)
         if not self.is_piecewise:
             return sympy.Add(*[EPSILON**w.order * w.to_expr(frequency * TIME) for w in self.waveforms])
         folded = sympy.Abs(sympy.Mod(frequency * TIME + sympy.pi, 2 * sympy.pi) - sympy.pi)
-        pieces = [sympy.Add(*[EPSILON**w.order * w.branches[p] for w in self.waveforms]) for p in range(len(self.waveforms[0].branches))]
+        pieces = [sympy.Add(*[self.gauge**w.order * w.branches[p] for w in self.waveforms]) for p in range(len(self.waveforms[0].branches))]
         boundaries = [
-            sympy.Add(*[EPSILON**k * self.contact_angle_correction(k)[index] for k in range(1, self.order + 1)], angle)
+            sympy.Add(*[self.gauge**k * self.contact_angle_correction(k)[index] for k in range(1, self._steps * self.order + 1)], angle)
             for index, angle in enumerate(self.contact_angles)
         ]
         conditions = [(piece.subs(STRAINED_TIME, folded), folded <= boundary) for piece, boundary in zip(pieces, boundaries)]
@@ -506,9 +552,9 @@ class Expansion:
         else:
             condition = r"\dot u(0) = 0,\ " + _latex(problem.a0) + r" = \text{first-harmonic amplitude}"
         lines = [r"& " + equation + r",\quad " + condition]
-        for k, value in enumerate(self.omega):
-            lines.append(rf"\omega_{{{k}}} &= {_latex(value)}")
-        lines.append(r"\omega(\varepsilon) &= " + _latex(self.frequency_expr()) + rf" + O(\varepsilon^{{{self.order + 1}}})")
+        for exponent, value in zip(self.exponents, self.omega):  # ω_{k/2} multiplies ε^{k/2} in the gauge sqrt(ε)
+            lines.append(rf"\omega_{{{exponent}}} &= {_latex(value)}")
+        lines.append(r"\omega(\varepsilon) &= " + _latex(self.frequency_expr()) + rf" + O(\varepsilon^{{{_latex(sympy.Rational(self._steps * self.order + 1, self._steps))}}})")
         if waveforms:
             for waveform in self.waveforms:
                 lines.append(rf"v_{{{waveform.order}}}(s) &= {waveform.to_latex()}")
@@ -530,6 +576,8 @@ class Expansion:
             },
             "order": self.order,
             "normalization": problem.normalization,
+            "gauge": sympy.sstr(self.gauge),
+            "exponents": [str(value) for value in self.exponents],
             "omega": [sympy.sstr(value) for value in self.omega],
             "omega_float": [_as_float(value) for value in self.omega],
             "alpha": [sympy.sstr(value) for value in self.alpha],
@@ -556,6 +604,8 @@ class Expansion:
     def summary(self) -> str:
         """Plain-text summary: the problem and ω_0..ω_N."""
         lines = [self.problem.describe()]
+        if self._steps != 1:
+            lines.append(f"  omega(eps) = sum_k omega_k {self.gauge}**k (grazing: not analytic in eps)")
         for k, value in enumerate(self.omega):
             lines.append(f"  omega_{k} = {value}")
         return "\n".join(lines)

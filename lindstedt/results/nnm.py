@@ -17,6 +17,7 @@ import mpmath
 import numpy as np
 import sympy
 
+from .._errors import ProblemError
 from ..engine.branches import BranchHierarchy, FloatBranches
 from ..problems.nnm import NNMProblem
 from ..problems.system import UnilateralSystem
@@ -40,15 +41,19 @@ class NNMExpansion:
     lambdas : tuple of float
         All linear frequencies λ_1 ≤ … ≤ λ_N.
     omega : tuple of mpf
-        (λ_j, ω_1, …, ω_order) with ω(ε) = Σ ω_n ε^n.
+        (λ_j, ω_1, …, ω_order) with ω(ε) = Σ ω_n ε^n; when ``gauge`` is 2,
+        (λ_j, ω_{1/2}, ω_1, …, ω_order) with ω(ε) = Σ_n ω_{n/2} ε^{n/2}.
     alpha : tuple of mpf
-        ω² = Σ α_n ε^n.
+        ω² = Σ α_n ε^n (same gauge).
     release_modal : tuple of mpf
         a_k = v_k^1(0) for every mode k (a_j = a1): u_k(0) = ε a_k.
     validity_exponent : sympy.Rational
         −1 (all contact roots simple) or −1/2 (a spring grazes: double root).
     spring_roots : tuple of str
         Per spring: "simple", "double" (grazing), "none" (never/always in contact).
+    gauge : int
+        1: series in ε; 2: in ε^{1/2} — a grazing spring (touching its gap at a turning point
+        of the linear mode) that the perturbed orbit passes makes ω(ε) non-analytic.
     small_divisors : tuple of (mode, harmonic, divisor)
         Near-resonance report: |r_k² − n²| for the closest harmonic n of each mode k ≠ j;
         the amplification of mode k is ~1/divisor.
@@ -72,6 +77,7 @@ class NNMExpansion:
     validity_exponent: sympy.Rational
     spring_roots: tuple[str, ...]
     small_divisors: tuple[tuple[int, int, float], ...]
+    gauge: int
     _hierarchy: BranchHierarchy = field(repr=False, compare=False)
 
     @property
@@ -98,9 +104,20 @@ class NNMExpansion:
         return tuple(value for k, value in enumerate(self.release_modal) if k != self.mode - 1)
 
     def frequency(self, epsilon: Any) -> Any:
-        """ω(ε) = Σ_{n≤order} ω_n ε^n (vectorised)."""
+        """ω(ε) = Σ_n ω_n η^n (vectorised), η = ε, or ε^{1/2} when ``gauge`` is 2."""
         coefficients = np.array([float(w) for w in self.omega])
-        return np.polynomial.polynomial.polyval(np.asarray(epsilon, dtype=float), coefficients)
+        return np.polynomial.polynomial.polyval(self._gauge_values(epsilon), coefficients)
+
+    def _gauge_values(self, epsilon: Any) -> np.ndarray:
+        points = np.asarray(epsilon, dtype=float)
+        if self.gauge == 1:
+            return points
+        if np.any(points < 0):
+            raise ProblemError(
+                "this NNM is expanded in powers of sqrt(epsilon) (a grazing spring that the perturbed orbit passes): "
+                "it holds for epsilon >= 0; for epsilon < 0 use lindstedt.nnm_point"
+            )
+        return np.sqrt(points)
 
     def modal_displacement(self, t: Any, epsilon: float) -> np.ndarray:
         """Modal coordinates U(t) ≈ a0 Σ_{n<N} ε̂^n W_n(ω t), ω through ω_N (shape ``t.shape + (N_dof,)``).
@@ -111,12 +128,13 @@ class NNMExpansion:
         """
         lam = float(self.omega[0])
         strained = np.asarray(t, dtype=float) * float(self.frequency(epsilon))
-        return self.a0 * self._float_branches.evaluate(strained, float(epsilon) / (lam * lam))
+        scaled = float(self._gauge_values(float(epsilon))) * (lam * lam) ** (-1 / self.gauge)
+        return self.a0 * self._float_branches.evaluate(strained, scaled)
 
     @cached_property
     def _float_branches(self) -> FloatBranches:
         """W_0 … W_{N−1} as floats (built once)."""
-        return self._hierarchy.float_branches(max(self.order - 1, 0))
+        return self._hierarchy.float_branches(max(self.gauge * self.order - 1, 0))
 
     def displacement(self, t: Any, epsilon: float) -> np.ndarray:
         """Physical X(t) = Φ U(t) of :meth:`modal_displacement` (shape ``t.shape + (N_dof,)``).
@@ -146,6 +164,7 @@ class NNMExpansion:
             "a0": self.a0,
             "a1": self.a1,
             "order": self.order,
+            "gauge": "epsilon" if self.gauge == 1 else "sqrt(epsilon)",
             "lambda": list(self.lambdas),
             "omega": [float(w) for w in self.omega],
             "omega_digits": [mpmath.nstr(w, self.digits) for w in self.omega],
@@ -162,8 +181,8 @@ class NNMExpansion:
     def to_latex(self) -> str:
         """A LaTeX fragment with λ_j, ω_1, ω_2 and the a_k."""
         lines = [rf"\lambda_{{{self.mode}}} &= {mpmath.nstr(self.omega[0], 15)}"]
-        for n in range(1, len(self.omega)):
-            lines.append(rf"\omega_{{{n}}} &= {mpmath.nstr(self.omega[n], 15)}")
+        for n in range(1, len(self.omega)):  # ω_{n/gauge} multiplies ε^{n/gauge}
+            lines.append(rf"\omega_{{{sympy.Rational(n, self.gauge)}}} &= {mpmath.nstr(self.omega[n], 15)}")
         for k, value in enumerate(self.release_modal):
             if k != self.mode - 1:
                 lines.append(rf"a_{{{k + 1}}} &= {mpmath.nstr(value, 15)}")
