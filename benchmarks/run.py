@@ -36,6 +36,7 @@ REGISTRY: dict[str, tuple[str, str]] = {
     "nnm-branch": ("bench_nnm_branch", "run"),
     "nnm-scaling": ("bench_nnm_scaling", "run"),
     "method-pairs": ("bench_method_pairs", "run"),
+    "codegen-stability": ("bench_codegen_stability", "run"),
 }
 
 

@@ -66,7 +66,12 @@ def _notebook_sources(path: Path) -> list[tuple[str, str]]:
 def _checked_files() -> list[Path]:
     files = sorted((ROOT / "tests").glob("*.py"))
     for directory in ("notebooks", "benchmarks", "derivations"):
-        files += sorted(path for path in (ROOT / directory).rglob("*") if path.is_file() and path.suffix in {".py", ".ipynb", ".md"})
+        files += sorted(
+            path
+            for path in (ROOT / directory).rglob("*")
+            # hidden folders are tooling (the benchmarks' cached peer venvs), not project files
+            if path.is_file() and path.suffix in {".py", ".ipynb", ".md"} and not any(part.startswith(".") for part in path.relative_to(ROOT).parts)
+        )
     return files
 
 

@@ -43,6 +43,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 import sympy
 
+from .accuracy import ExpansionValidityWarning, phase_warning, series_warning
 from .assumptions import DerivationAssumptions, shown_values
 from .._errors import OrderError, ParameterError
 from ..algebra.branch import Branch, EvaluationPoint
@@ -54,8 +55,6 @@ from ..engine.smooth import MAX_ORDER, NormalForm, SmoothHierarchy
 __all__ = ["Expansion", "ExpansionValidityWarning", "Waveform", "PiecewiseWaveform", "STRAINED_TIME", "EPSILON", "TIME"]
 
 
-class ExpansionValidityWarning(UserWarning):
-    """A numeric evaluation outside the range where the truncated series is meaningful."""
 
 STRAINED_TIME = sympy.Symbol("s", real=True)
 EPSILON = sympy.Symbol("epsilon", real=True)
@@ -373,19 +372,9 @@ class Expansion:
         coefficients = self._frequency_coefficients(last + 1, values)
         points = self._gauge_values(epsilon)
         result = np.polynomial.polynomial.polyval(points, coefficients[: last + 1])
-        if last >= 1:
-            next_term = np.abs(coefficients[last + 1] * points ** (last + 1))
-            correction = np.abs(result - coefficients[0])
-            if np.any(next_term > np.maximum(correction, 1e-300)):
-                warnings.warn(
-                    ExpansionValidityWarning(
-                        f"at eps = {np.max(np.abs(np.asarray(epsilon, dtype=float))):.3g} the next term "
-                        f"omega_{last + 1} {self.gauge}^{last + 1} is larger than "
-                        "the whole correction: the series is not converging there; use a smaller eps or a numerical "
-                        "method (lindstedt.reference_solution, lindstedt.nnm_point)"
-                    ),
-                    stacklevel=2,
-                )
+        message = series_warning(coefficients, last, points, str(self.gauge))
+        if message:
+            warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
         return float(result) if np.ndim(result) == 0 else result
 
     def truncation_error_estimate(self, epsilon: Any, values: Mapping[Any, Any] | None = None, *, order: int | None = None) -> Any:
@@ -459,9 +448,16 @@ class Expansion:
     def _evaluate(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None, derivative: bool) -> Any:
         scale, amplitude, branches = self._float_branches(values)
         gauge = float(self._gauge_values(float(epsilon)))
-        coefficients = self._frequency_coefficients(self._steps * self.order + 1, values)
+        last = self._steps * self.order
+        coefficients = self._frequency_coefficients(last + 1, values)
         frequency = float(np.polynomial.polynomial.polyval(gauge, coefficients))
-        strained = np.asarray(t, dtype=float) * frequency
+        times = np.asarray(t, dtype=float)
+        message = series_warning(coefficients, last, np.array([gauge]), str(self.gauge)) or phase_warning(
+            coefficients[last + 1], last + 1, gauge, times
+        )
+        if message:
+            warnings.warn(ExpansionValidityWarning(message), stacklevel=3)
+        strained = times * frequency
         result = amplitude * branches.evaluate(strained, scale ** (1 / self._steps) * gauge, derivative)[..., 0]
         if derivative:
             result = result * frequency

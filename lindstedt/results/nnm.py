@@ -9,6 +9,7 @@ contact angles; exports to JSON (schema ``lindstedt.nnm/1``) and LaTeX.
 from __future__ import annotations
 
 import json
+import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
@@ -19,6 +20,7 @@ import sympy
 
 from .._errors import ProblemError
 from ..engine.branches import BranchHierarchy, FloatBranches
+from .accuracy import ExpansionValidityWarning, phase_warning, series_warning
 from ..problems.nnm import NNMProblem
 from ..problems.system import UnilateralSystem
 
@@ -104,9 +106,41 @@ class NNMExpansion:
         return tuple(value for k, value in enumerate(self.release_modal) if k != self.mode - 1)
 
     def frequency(self, epsilon: Any) -> Any:
-        """ω(ε) = Σ_n ω_n η^n (vectorised), η = ε, or ε^{1/2} when ``gauge`` is 2."""
-        coefficients = np.array([float(w) for w in self.omega])
-        return np.polynomial.polynomial.polyval(self._gauge_values(epsilon), coefficients)
+        """ω(ε) = Σ_n ω_n η^n (vectorised), η = ε, or ε^{1/2} when ``gauge`` is 2.
+
+        Warns (:class:`~lindstedt.ExpansionValidityWarning`) where the series does not
+        converge: its terms grow, or the next term exceeds the whole correction.
+
+        Examples
+        --------
+        >>> import lindstedt, warnings
+        >>> mode = lindstedt.nnm(lindstedt.UnilateralSystem.one_dof(1, a=1, b=0), mode=1, a0=1, order=2)
+        >>> float(mode.frequency(0.1))
+        1.02375
+        >>> with warnings.catch_warnings(record=True) as caught:
+        ...     warnings.simplefilter("always")
+        ...     _ = mode.frequency(10.0)
+        >>> "not converging" in str(caught[0].message)
+        True
+        """
+        eta = self._gauge_values(epsilon)
+        message = series_warning(self._coefficients, len(self.omega) - 1, np.atleast_1d(eta), self._gauge_name)
+        if message:
+            warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
+        return np.polynomial.polynomial.polyval(eta, self._coefficients[:-1])
+
+    @property
+    def _gauge_name(self) -> str:
+        return "eps" if self.gauge == 1 else "sqrt(eps)"
+
+    @cached_property
+    def _coefficients(self) -> np.ndarray:
+        """ω_0 … ω_n and the next coefficient ω_{n+1} (derived on first use), as floats."""
+        lam = self.omega[0]
+        steps = self.gauge
+        index = steps * self.order + 1
+        next_value = self._hierarchy.frequency(index) * lam * lam ** (-2 * mpmath.mpf(index) / steps)
+        return np.array([float(w) for w in self.omega] + [float(next_value)])
 
     def _gauge_values(self, epsilon: Any) -> np.ndarray:
         points = np.asarray(epsilon, dtype=float)
@@ -127,8 +161,16 @@ class NNMExpansion:
         on t ≤ C/ε (Theorem 4.1 for N = 2: u = v⁰ + ε v¹ + O(ε²)).
         """
         lam = float(self.omega[0])
-        strained = np.asarray(t, dtype=float) * float(self.frequency(epsilon))
-        scaled = float(self._gauge_values(float(epsilon))) * (lam * lam) ** (-1 / self.gauge)
+        eta = float(self._gauge_values(float(epsilon)))
+        times = np.asarray(t, dtype=float)
+        last = len(self.omega) - 1
+        message = series_warning(self._coefficients, last, np.array([eta]), self._gauge_name) or phase_warning(
+            self._coefficients[-1], last + 1, eta, times
+        )
+        if message:
+            warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
+        strained = times * float(np.polynomial.polynomial.polyval(eta, self._coefficients[:-1]))
+        scaled = eta * (lam * lam) ** (-1 / self.gauge)
         return self.a0 * self._float_branches.evaluate(strained, scaled)
 
     @cached_property

@@ -1,0 +1,76 @@
+"""Honest accuracy of a truncated series ω(ε) = Σ_{k≤n} ω_k η^k (η = ε or ε^{1/2}) and of its waveform.
+
+Read off the coefficients the expansion already has (ω_0 … ω_{n+1}):
+
+* the **first neglected term** |ω_{n+1} η^{n+1}| estimates the frequency's truncation error
+  while the series converges;
+* the series has **left its disc of convergence** where its terms |ω_k η^k| stop falling:
+  a grazing nearby (the orbit reaching a breakpoint tangentially at some ε_g) is a
+  singularity of ω(ε) at ε_g, and beyond it every order makes the value worse.  The terms
+  are compared in pairs (the last two kept and the next one against the two before), which
+  is robust to the interleaved analytic and non-analytic terms of the gauge ε^{1/2};
+* over time the waveform's error is dominated by the phase drift |ω_{n+1} η^{n+1}| t, so
+  ``u(t)`` is meaningless once that reaches one radian.
+
+:func:`series_warning` and :func:`phase_warning` return the text of an
+:class:`ExpansionValidityWarning` (or None); the results emit it.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+__all__ = ["ExpansionValidityWarning", "phase_warning", "series_warning"]
+
+
+class ExpansionValidityWarning(UserWarning):
+    """A numeric evaluation outside the range where the truncated series is meaningful."""
+
+
+def series_warning(coefficients: Sequence[float], last: int, eta: np.ndarray, gauge: str) -> str | None:
+    """Why ``Σ_{k≤last} ω_k η^k`` should not be trusted at some of ``eta`` (``coefficients`` run to last + 1), or None.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> series_warning([1.0, 0.5, 0.25, 0.125, 0.0625], 3, np.array([0.1]), "eps") is None   # Σ (η/2)^k, η < 2
+    True
+    >>> "radius" in series_warning([1.0, 0.5, 0.25, 0.125, 0.0625], 3, np.array([3.0]), "eps")
+    True
+    """
+    if last < 1 or eta.size == 0:
+        return None
+    worst = float(np.max(np.abs(eta)))
+    terms = [abs(float(value)) * worst**k for k, value in enumerate(coefficients[: last + 2])]
+    correction = abs(sum(float(value) * worst**k for k, value in enumerate(coefficients[1 : last + 1], start=1)))
+    if last >= 3 and max(terms[last], terms[last + 1]) > max(terms[last - 2], terms[last - 1]):
+        return (
+            f"at {gauge} = {worst:.3g} the series is not converging: its terms grow (|omega_k {gauge}^k| = "
+            + ", ".join(f"{term:.2g}" for term in terms[1:])
+            + "): eps is beyond the radius of convergence (a grazing or another singularity of omega(eps) is that "
+            "close) and no truncation is reliable; use a smaller eps or a numerical method "
+            "(lindstedt.reference_solution, lindstedt.nnm_point)"
+        )
+    if terms[last + 1] > max(correction, 1e-300):
+        return (
+            f"at {gauge} = {worst:.3g} the next term omega_{last + 1} {gauge}^{last + 1} = {terms[last + 1]:.3g} is larger "
+            "than the whole correction: the series is not converging there; use a smaller eps or a numerical method "
+            "(lindstedt.reference_solution, lindstedt.nnm_point)"
+        )
+    return None
+
+
+def phase_warning(next_coefficient: float, next_power: int, eta: float, times: np.ndarray) -> str | None:
+    """The phase drift |ω_{n+1} η^{n+1}| t reaches one radian at some of ``times``: the waveform is meaningless there."""
+    if times.size == 0:
+        return None
+    drift = abs(float(next_coefficient)) * abs(eta) ** next_power * float(np.max(np.abs(times)))
+    if not drift < 1.0:
+        return (
+            f"at t = {float(np.max(np.abs(times))):.3g} the phase error of the truncated frequency, "
+            f"|omega_{next_power}| eta^{next_power} t = {drift:.3g} rad, is not small: the waveform holds on "
+            "t << 1/|omega_next eta^next| only; use a higher order, a smaller eps or lindstedt.reference_solution"
+        )
+    return None
