@@ -15,8 +15,9 @@ in powers of eps^(1/2), with the first non-analytic term -8/(3 pi) eps^(5/2)
 
 Checks against the exact frequency (``lindstedt.references.piecewise_linear_exact_frequency``,
 closed-form period of the piecewise-linear oscillator, 30 digits) at eps = 1e-2, 1e-3,
-1e-4: for b = a0 the expansion equals it to within 1e-25; for b = -a0 the remainder
-stays within twice the first neglected term.
+1e-4: for b = a0 the expansion equals it to within 1e-25; for b = -a0, and for the
+release just inside the gap (u(0) = 1 + eps, seed Prop. 2.3), the remainder stays within
+twice the first neglected term.
 
 Run::
 
@@ -61,6 +62,7 @@ EPSILON = sympy.Symbol("epsilon", real=True)  # lindstedt's symbol for eps in fr
 #: b = -a0: the remainder over the first neglected term tends to 1 as eps -> 0; at eps = 1e-2 the
 #: next terms add at most |omega_{k+1}/omega_k| eps^(1/2) <= 0.7 (order 1: -1/8 eps^2 then -8/(3 pi) eps^(5/2)).
 REMAINDER_RATIO = 2.0
+LATEX_LABELS = {"b = -a0": r"$b = -a_{0}$", "b = a0, a1 = 1": r"$b = a_{0},\ a_{1} = 1$"}
 
 
 def derive(order: int) -> common.Sheet:
@@ -75,13 +77,16 @@ def derive(order: int) -> common.Sheet:
         r"$\omega(\varepsilon)$ is expanded in powers of $\varepsilon^{1/2}$."
     )
     cases = (
-        ("b = a0", 1, r"$b = a_{0} = 1$: the release point touches the spring, no contact; $\omega = \omega_{0}$ exactly."),
-        ("b = -a0", -1, r"$b = -a_{0} = -1$: in contact except at the far turning point, which the perturbed orbit "
-                        r"passes: a free arc of length $O(\varepsilon^{1/2})$ opens there."),
+        ("b = a0", 1, 0, r"$b = a_{0} = 1$: the release point touches the spring, no contact; $\omega = \omega_{0}$ exactly."),
+        ("b = -a0", -1, 0, r"$b = -a_{0} = -1$: in contact except at the far turning point, which the perturbed orbit "
+                           r"passes: a free arc of length $O(\varepsilon^{1/2})$ opens there."),
+        ("b = a0, a1 = 1", 1, 1, r"$b = a_{0} = 1$, released just inside the gap at $u(0) = 1 + \varepsilon$ (seed Prop. 2.3): "
+                                 r"a contact arc of length $O(\varepsilon^{1/2})$ around the release point; the linear "
+                                 r"approximation $\omega_0$ misses a term $\propto \varepsilon^{5/2}$."),
     )
     table = {}
-    for label, b, heading in cases:
-        expansion = lindstedt.expand(f"Max(0, u - ({b}))", order=order, a0=1)
+    for label, b, a1, heading in cases:
+        expansion = lindstedt.expand(f"Max(0, u - ({b}))", order=order, a0=1, a1=a1)
         sheet.add_expansion(label, expansion, heading)
 
         # the truncated omega(eps) = sum_k omega_k gauge^k (omega0 = 1) against the exact frequency
@@ -93,7 +98,7 @@ def derive(order: int) -> common.Sheet:
         rows, worst = [], 0.0
         for epsilon in EPSILONS:
             with mpmath.workdps(DIGITS):  # the difference of two 30-digit numbers, taken at 30 digits
-                row, ratio = _compare(epsilon, b, truncated, first_neglected)
+                row, ratio = _compare(epsilon, b, a1, truncated, first_neglected)
             rows.append(row)
             worst = max(worst, ratio)
         table[label] = rows
@@ -102,7 +107,7 @@ def derive(order: int) -> common.Sheet:
             + common.align([rf"\varepsilon = 10^{{{int(row['epsilon'][2:])}}}:\ \omega_{{\mathrm{{exact}}}} - \omega_{{\le {order}}} "
                             rf"&= {common.sci(float(row['difference']), 3)}" for row in rows])
         )
-        if b == 1:  # the exact solution is a0 cos(omega0 t): the expansion must be exact
+        if b == 1 and not a1:  # the exact solution is a0 cos(omega0 t): the expansion must be exact
             sheet.check(label, "omega(epsilon)", "the exact frequency (closed-form period) at epsilon = 1e-2, 1e-3, 1e-4",
                         worst, EXACT_TOLERANCE,
                         latex=(r"$b = a_{0}$", r"$\omega(\varepsilon)$",
@@ -110,7 +115,7 @@ def derive(order: int) -> common.Sheet:
         else:  # asymptotic: the remainder is the first neglected term plus smaller ones
             sheet.check(label, "|omega_exact - omega_N| / |first neglected term|",
                         "the exact frequency (closed-form period) at epsilon = 1e-2, 1e-3, 1e-4", worst, REMAINDER_RATIO,
-                        latex=(r"$b = -a_{0}$", r"$|\omega_{\mathrm{exact}} - \omega_{\le N}| / |\text{first neglected term}|$",
+                        latex=(LATEX_LABELS[label], r"$|\omega_{\mathrm{exact}} - \omega_{\le N}| / |\text{first neglected term}|$",
                                r"the exact frequency (closed-form period) at $\varepsilon = 10^{-2}, 10^{-3}, 10^{-4}$"))
     sheet.extra["exact_comparison"] = {
         "omega0": "1",
@@ -120,16 +125,17 @@ def derive(order: int) -> common.Sheet:
     return sheet
 
 
-def _compare(epsilon: str, b: int, truncated: sympy.Expr, first_neglected: sympy.Expr) -> tuple[dict, float]:
+def _compare(epsilon: str, b: int, a1: int, truncated: sympy.Expr, first_neglected: sympy.Expr) -> tuple[dict, float]:
     """One row of the table and the checked number: |difference| (b = a0) or |difference| / |first neglected term|."""
-    exact = references.piecewise_linear_exact_frequency(epsilon, a=1, b=b, a0=1, omega0=1, precision=DIGITS)
+    release = 1 + a1 * mpmath.mpf(epsilon)  # u(0) = a0 + eps a1
+    exact = references.piecewise_linear_exact_frequency(epsilon, a=1, b=b, a0=release, omega0=1, precision=DIGITS)
     value = sympy.Rational(epsilon)
     approximate = mpmath.mpf(str(sympy.N(truncated.subs(EPSILON, value), DIGITS)))
     neglected = abs(mpmath.mpf(str(sympy.N(first_neglected.subs(EPSILON, value), DIGITS))))
     difference = exact - approximate
     row = {"epsilon": epsilon, "exact": mpmath.nstr(exact, 20), "expansion": mpmath.nstr(approximate, 20),
            "difference": mpmath.nstr(difference, 6), "first_neglected_term": mpmath.nstr(neglected, 6)}
-    return row, abs(float(difference)) if b == 1 else float(abs(difference) / neglected)
+    return row, abs(float(difference)) if (b == 1 and not a1) else float(abs(difference) / neglected)
 
 
 if __name__ == "__main__":

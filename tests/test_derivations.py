@@ -165,9 +165,10 @@ def test_derivation_writes_valid_latex_and_json(results, name):
     assert data["schema"] == "lindstedt.derivation/1" and data["name"] == name and data["order"] == result.order
     assert data["omega"] and data["omega"].keys() == data["omega_float"].keys()
     expected_length = 2 if name == "all_modes" else result.order + 1
+    gauges = {variant["label"]: variant.get("expansion", {}).get("gauge") for variant in data.get("variants", [])}
     for label, values in data["omega"].items():
-        # the grazing case b = -a0 is expanded in powers of eps^(1/2): 2N + 1 coefficients
-        length = 2 * result.order + 1 if (name, label) == ("grazing", "b = -a0") else expected_length
+        # an expansion in powers of eps^(1/2) (grazing passed by the perturbed orbit) has 2N + 1 coefficients
+        length = 2 * result.order + 1 if gauges.get(label) == "sqrt(epsilon)" else expected_length
         assert len(values) == length and all(isinstance(value, str) for value in values)
     assert all(check["agrees"] for check in data["checks"]), data["checks"]
 
@@ -238,7 +239,8 @@ def test_grazing_flags_the_regime_and_expands_in_the_right_gauge(results):
     data = results["grazing"].json
     for variant in data["variants"]:
         assert variant["regime"] == "grazing"
-    touching, passing = data["variants"]
+    touching, passing, inside = data["variants"]
+    assert inside["expansion"]["gauge"] == "sqrt(epsilon)" and inside["expansion"]["problem"]["a1"] == "1"
     assert touching["validity"]["exponent"] == "-1/2" and touching["contact_angles"] == []
     assert data["omega"]["b = a0"] == ["omega0", "0", "0"]
     assert {row["difference"] for row in data["exact_comparison"]["rows"]["b = a0"]} == {"0.0"}

@@ -79,7 +79,9 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="NAME=VALUE",
         help="declare a parameter of f with its value; NAME alone keeps it symbolic (repeatable)",
     )
-    expand.add_argument("--normalization", choices=("initial", "harmonic"), default="initial")
+    expand.add_argument("--normalization", choices=("initial", "harmonic"), default="initial",
+                        help="initial: a0 is u(0); harmonic: a0 is the first-harmonic amplitude")
+    expand.add_argument("--a1", default="0", help="release at u(0) = a0 + eps*a1 (default 0; e.g. just inside a gap that a0 touches)")
     expand.add_argument("--format", choices=("text", "latex", "json"), default="text")
     expand.add_argument("--waveforms", action="store_true", help="include the waveforms v_k in text/LaTeX output")
     expand.add_argument("--precision", type=int, default=30, help="decimal digits for non-polynomial f (default 30)")
@@ -122,6 +124,7 @@ def _command_expand(arguments: argparse.Namespace) -> str:
         params=_parse_parameters(arguments.param),
         normalization=arguments.normalization,
         precision=arguments.precision,
+        a1=arguments.a1,
     )
     if arguments.format == "json":
         return expansion.to_json()

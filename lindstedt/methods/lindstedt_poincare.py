@@ -122,7 +122,7 @@ def _problem_key(problem: Oscillator) -> tuple:
     Parameters are sorted by name (their declaration order does not change the problem).
     """
     params = tuple(sorted(problem.params, key=lambda item: item[0].name))
-    return (problem.f, problem.a0, problem.omega0, params, problem.normalization)
+    return (problem.f, problem.a0, problem.omega0, params, problem.normalization, problem.a1)
 
 
 class LindstedtPoincare:
@@ -224,6 +224,7 @@ def expand(
     normalization: str = "initial",
     precision: int = 30,
     numeric: bool = False,
+    a1: Any = 0,
 ) -> Expansion:
     """Lindstedt–Poincaré expansion of ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0``, ``u'(0) = 0``.
 
@@ -245,6 +246,8 @@ def expand(
     numeric : bool
         Piecewise-linear f: work in ``precision``-digit floats instead of exactly
         (much faster at high order; exact inputs otherwise give exact results).
+    a1 : number, str or sympy expression
+        Release at u(0) = a0 + ε a1 (default 0), e.g. just inside a gap that a0 touches.
 
     Returns
     -------
@@ -258,10 +261,10 @@ def expand(
     """
     validate_order(order)
     if isinstance(f, Oscillator):
-        if a0 is not None or omega0 is not None or params is not None or normalization != "initial":
+        if a0 is not None or omega0 is not None or params is not None or normalization != "initial" or a1 != 0:
             raise TypeError("pass either an Oscillator or f with its problem arguments, not both")
         problem = f
     else:
-        problem = Oscillator(f, a0=a0, omega0=omega0, params=params, normalization=normalization)
+        problem = Oscillator(f, a0=a0, omega0=omega0, params=params, normalization=normalization, a1=a1)
     # The hierarchy is taken from the process-wide cache (see lindstedt.clear_cache).
     return LindstedtPoincare(precision=precision, numeric=numeric).expand(problem, order)

@@ -1,4 +1,4 @@
-"""The one-degree-of-freedom problem  u'' + ω0² u + ε f(u) = 0,  u(0) = a0,  u'(0) = 0.
+"""The one-degree-of-freedom problem  u'' + ω0² u + ε f(u) = 0,  u(0) = a0 + ε a1,  u'(0) = 0.
 
 ``Oscillator`` is a frozen dataclass that parses, sympifies and validates its
 inputs when it is built, so that every method downstream receives a problem
@@ -7,7 +7,8 @@ every declared parameter is used, ``a0 ≠ 0``, ``ω0 > 0``, and the amplitude
 normalisation is explicit:
 
 ``"initial"``
-    ``a0`` is the release point: u(0) = a0 exactly (every correction vanishes at s = 0).
+    ``a0`` is the release point: u(0) = a0 + ε a1 exactly (a1 = 0 by default; the
+    corrections v_k, k ≥ 2, vanish at s = 0 and v_1(0) = a1).
 ``"harmonic"``
     ``a0`` is the amplitude of the first harmonic: the ``cos(s)`` coefficient of
     every correction v_k, k ≥ 1, vanishes.
@@ -56,7 +57,7 @@ def _given_quantity(value: Any, what: str) -> sympy.Expr:
 
 @dataclass(frozen=True)
 class Oscillator:
-    """Weakly nonlinear oscillator ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0``, ``u'(0) = 0``.
+    """Weakly nonlinear oscillator ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0 + ε a1``, ``u'(0) = 0``.
 
     Parameters
     ----------
@@ -77,6 +78,10 @@ class Oscillator:
         (:data:`RESERVED_NAMES`) cannot be parameters.
     normalization : {"initial", "harmonic"}
         Meaning of ``a0``: release point, or first-harmonic amplitude.
+    a1 : number, numeric string or sympy expression, optional
+        The O(ε) shift of the release point, u(0) = a0 + ε a1 (default 0; "initial" normalization
+        only).  It matters where a0 sits exactly on a breakpoint: the release just inside or
+        outside a gap (seed Prop. 2.3).
 
     Raises
     ------
@@ -97,6 +102,7 @@ class Oscillator:
     omega0: Any = None
     params: Any = None
     normalization: str = "initial"
+    a1: Any = 0
     variable: sympy.Symbol = field(default=DISPLACEMENT, init=False)
 
     def __post_init__(self) -> None:
@@ -147,8 +153,11 @@ class Oscillator:
 
         amplitude = self._parse_amplitude(self.a0)
         omega0 = self._parse_omega0(self.omega0)
+        release_shift = _given_quantity(self.a1, "a1")
+        if release_shift != 0 and self.normalization != "initial":
+            raise ProblemError("a1 shifts the release point u(0) = a0 + eps*a1: it needs normalization='initial'")
 
-        used = expression.free_symbols | amplitude.free_symbols | omega0.free_symbols
+        used = expression.free_symbols | amplitude.free_symbols | omega0.free_symbols | release_shift.free_symbols
         unused = [name for name, symbol in parameter_symbols.items() if symbol not in used]
         if unused:
             raise ParameterError(
@@ -158,6 +167,7 @@ class Oscillator:
         set_field(self, "f", expression)
         set_field(self, "a0", amplitude)
         set_field(self, "omega0", omega0)
+        set_field(self, "a1", release_shift)
         set_field(self, "params", tuple((parameter_symbols[name], values[name]) for name in raw_params))
 
     # -- parsing of the amplitude and of the linear frequency -------------------------------
@@ -205,7 +215,7 @@ class Oscillator:
     def free_symbols(self) -> set[sympy.Symbol]:
         """Symbols a numeric evaluation must be given: a0, ω0 or parameters left symbolic."""
         symbols = set(self.nonlinearity.free_symbols) - {DISPLACEMENT}
-        return symbols | self.a0.free_symbols | self.omega0.free_symbols
+        return symbols | self.a0.free_symbols | self.omega0.free_symbols | self.a1.free_symbols
 
     @property
     def is_non_smooth(self) -> bool:
@@ -256,7 +266,8 @@ class Oscillator:
         squared = self.omega0**2
         stiffness = f"({sympy.sstr(squared)})" if isinstance(squared, sympy.Add) else sympy.sstr(squared)
         stiffness_term = "u" if squared == 1 else f"{stiffness}*u"
-        text = f"u'' + {stiffness_term} + eps*({self.f}) = 0, u(0) = {self.a0} [{self.normalization}]"
+        release = f"{self.a0}" if self.a1 == 0 else f"{self.a0} + eps*({self.a1})"
+        text = f"u'' + {stiffness_term} + eps*({self.f}) = 0, u(0) = {release} [{self.normalization}]"
         if params:
             text += f"; {params}"
         if symbolic:

@@ -16,7 +16,7 @@ JSON schema ``lindstedt.expansion/1`` (:meth:`Expansion.to_dict`)::
 
     {
       "schema": "lindstedt.expansion/1",
-      "problem": {"equation": str, "f": str, "a0": str, "omega0": str,
+      "problem": {"equation": str, "f": str, "a0": str, "a1": str, "omega0": str,
                   "parameters": {name: str}, "normalization": str},
       "order": int, "normalization": "initial" | "harmonic",
       "gauge": "epsilon" | "sqrt(epsilon)",    # ω(ε) = Σ_k ω_k gauge^k
@@ -544,7 +544,8 @@ class Expansion:
             r"\ddot u + " + _latex(problem.omega0**2) + r" u + \varepsilon\left(" + _latex(problem.f.subs(problem.variable, u)) + r"\right) = 0"
         )
         if problem.normalization == "initial":
-            condition = r"u(0) = " + _latex(problem.a0) + r",\ \dot u(0) = 0"
+            release = _latex(problem.a0) + ("" if problem.a1 == 0 else r" + \varepsilon " + _latex(problem.a1))
+            condition = r"u(0) = " + release + r",\ \dot u(0) = 0"
         else:
             condition = r"\dot u(0) = 0,\ " + _latex(problem.a0) + r" = \text{first-harmonic amplitude}"
         lines = [r"& " + equation + r",\quad " + condition]
@@ -563,9 +564,10 @@ class Expansion:
         data: dict[str, Any] = {
             "schema": SCHEMA,
             "problem": {
-                "equation": "u'' + omega0**2*u + epsilon*f(u) = 0, u'(0) = 0",
+                "equation": "u'' + omega0**2*u + epsilon*f(u) = 0, u(0) = a0 + epsilon*a1, u'(0) = 0",
                 "f": sympy.sstr(problem.f),
                 "a0": sympy.sstr(problem.a0),
+                "a1": sympy.sstr(problem.a1),
                 "omega0": sympy.sstr(problem.omega0),
                 "parameters": {str(symbol): sympy.sstr(value) for symbol, value in problem.params},
                 "normalization": problem.normalization,

@@ -150,7 +150,8 @@ def _initial_displacement(source: Oscillator | Expansion, numeric: _NumericProbl
         assert isinstance(source, Expansion)
         start = float(np.asarray(source.displacement(0.0, epsilon, values)))
     else:
-        start = numeric.a0
+        substitution = problem.numeric_substitution(values)
+        start = numeric.a0 + epsilon * float(problem.a1.xreplace(substitution))  # the problem's own u(0) = a0 + ε a1
     return start + epsilon * a1
 
 
