@@ -22,7 +22,7 @@ from typing import Sequence
 
 import numpy as np
 
-__all__ = ["ExpansionValidityWarning", "phase_warning", "series_warning"]
+__all__ = ["ExpansionValidityWarning", "branch_bound", "displacement_error", "phase_warning", "series_warning"]
 
 
 class ExpansionValidityWarning(UserWarning):
@@ -74,3 +74,26 @@ def phase_warning(next_coefficient: float, next_power: int, eta: float, times: n
             "t << 1/|omega_next eta^next| only; use a higher order, a smaller eps or lindstedt.reference_solution"
         )
     return None
+
+
+def branch_bound(order_terms: Sequence, angles: Sequence[float]) -> float:
+    """max_{s∈[0,π]} |W_n(s)| from its float terms ``[piece][component] -> (ν, parity, m, c)``, piece p on
+    [angles[p−1], angles[p]] (0 and π at the ends), sampled at 65 points per piece (the terms are smooth
+    on each piece; the sampled maximum is an estimate, not a bound)."""
+    limits = [0.0, *[float(angle) for angle in angles], float(np.pi)]
+    largest = 0.0
+    for piece, (lower, upper) in zip(order_terms, zip(limits, limits[1:])):
+        s = np.linspace(lower, upper, 65)
+        for component in piece:
+            total = np.zeros_like(s)
+            for frequency, parity, power, value in component:
+                total += value * s**power * (np.cos(frequency * s) if parity == 0 else np.sin(frequency * s))
+            largest = max(largest, float(np.max(np.abs(total))))
+    return largest
+
+
+def displacement_error(amplitude: float, frequency_error: float, times: np.ndarray, neglected_term: float) -> np.ndarray:
+    """Estimated |u(t) − u_n(t)|: the phase drift |a0| δω t (``frequency_error`` δω: the first neglected terms of
+    the frequency used) plus ``neglected_term``, the size of the first neglected waveform term (the callers take
+    the last kept one, |a0| η̂^n max|W_n|, times η̂)."""
+    return abs(amplitude) * abs(frequency_error) * np.abs(times) + neglected_term

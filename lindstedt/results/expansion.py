@@ -43,7 +43,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 import sympy
 
-from .accuracy import ExpansionValidityWarning, phase_warning, series_warning
+from .accuracy import ExpansionValidityWarning, branch_bound, displacement_error, phase_warning, series_warning
 from .assumptions import DerivationAssumptions, shown_values
 from .._errors import OrderError, ParameterError
 from ..algebra.branch import Branch, EvaluationPoint
@@ -391,6 +391,29 @@ class Expansion:
         coefficient = self._frequency_coefficients(last + 1, values)[last + 1]
         return np.abs(coefficient * self._gauge_values(epsilon) ** (last + 1))
 
+    def displacement_error_estimate(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None = None) -> np.ndarray:
+        """Estimated error of :meth:`displacement` at ``t`` (vectorised): the phase drift |a0| δω t, δω the terms of ω
+        after ω_{n+1} (which the displacement uses) through one more power of ε, plus the first neglected waveform
+        term (the last kept one times η̂).
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> e = lindstedt.expand("u**3", order=2, a0=1, omega0=1)
+        >>> bool(e.displacement_error_estimate(10.0, 0.01) < 1e-5 < e.displacement_error_estimate(1e6, 0.01))
+        True
+        """
+        scale, amplitude, branches = self._float_branches(values)
+        last = self._steps * self.order
+        eta = float(self._gauge_values(float(epsilon)))
+        # The displacement pairs v_0 … v_n with ω through ω_{n+1}: its phase drifts with the next terms, one power of ε
+        # of them (two in the gauge ε^{1/2}, whose analytic and non-analytic terms interleave).
+        coefficients = self._frequency_coefficients(last + 1 + self._steps, values)
+        frequency_error = sum(abs(coefficients[k]) * abs(eta) ** k for k in range(last + 2, last + 2 + self._steps))
+        scaled = abs(scale) ** (1 / self._steps) * eta  # η̂, the normalised gauge of the waveforms
+        neglected = abs(amplitude) * scaled ** (last + 1) * branch_bound(branches.terms[last], branches.shifts[0])
+        return displacement_error(amplitude, frequency_error, np.asarray(t, dtype=float), neglected)
+
     def _gauge_values(self, epsilon: Any) -> np.ndarray:
         """The gauge at ε (ε itself, or √ε: then ε must not be negative)."""
         points = np.asarray(epsilon, dtype=float)
@@ -452,8 +475,9 @@ class Expansion:
         coefficients = self._frequency_coefficients(last + 1, values)
         frequency = float(np.polynomial.polynomial.polyval(gauge, coefficients))
         times = np.asarray(t, dtype=float)
+        drift = self._frequency_coefficients(last + 2, values)[last + 2]  # ω is used through ω_{n+1}: it drifts with ω_{n+2}
         message = series_warning(coefficients, last, np.array([gauge]), str(self.gauge)) or phase_warning(
-            coefficients[last + 1], last + 1, gauge, times
+            drift, last + 2, gauge, times
         )
         if message:
             warnings.warn(ExpansionValidityWarning(message), stacklevel=3)

@@ -20,7 +20,7 @@ import sympy
 
 from .._errors import ProblemError
 from ..engine.branches import BranchHierarchy, FloatBranches
-from .accuracy import ExpansionValidityWarning, phase_warning, series_warning
+from .accuracy import ExpansionValidityWarning, branch_bound, displacement_error, phase_warning, series_warning
 from ..problems.nnm import NNMProblem
 from ..problems.system import UnilateralSystem
 
@@ -128,6 +128,30 @@ class NNMExpansion:
         if message:
             warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
         return np.polynomial.polynomial.polyval(eta, self._coefficients[:-1])
+
+    def truncation_error_estimate(self, epsilon: Any) -> Any:
+        """|ω_{n+1} η^{n+1}|: the size of the first neglected term of ω(ε) (vectorised)."""
+        return np.abs(self._coefficients[-1] * self._gauge_values(epsilon) ** len(self.omega))
+
+    def displacement_error_estimate(self, t: Any, epsilon: float) -> np.ndarray:
+        """Estimated error of :meth:`modal_displacement` at ``t`` (vectorised, the worst modal coordinate): the phase
+        drift |a0 ω_{n+1} η^{n+1}| t plus the first neglected waveform term (the last kept one times η̂).
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> mode = lindstedt.nnm(lindstedt.UnilateralSystem.chain(2, unilateral=[(0, 0)]), mode=1, a0=1, order=2)
+        >>> bool(mode.displacement_error_estimate(10.0, 0.01) < 1e-4 < mode.displacement_error_estimate(1e7, 0.01))
+        True
+        """
+        eta = float(self._gauge_values(float(epsilon)))
+        lam = float(self.omega[0])
+        scaled = eta * (lam * lam) ** (-1 / self.gauge)
+        last = len(self.omega) - 1
+        kept = self._float_branches.terms[-1]  # W_{n−1}: the waveform pairs orders < n with ω through n
+        neglected = abs(self.a0) * abs(scaled) ** len(self._float_branches.terms) * branch_bound(kept, self._float_branches.shifts[0])
+        frequency_error = abs(self._coefficients[-1]) * abs(eta) ** (last + 1)
+        return displacement_error(self.a0, frequency_error, np.asarray(t, dtype=float), neglected)
 
     @property
     def _gauge_name(self) -> str:
