@@ -221,13 +221,16 @@ class FloatBranches:
         folded, sign = fold(np.asarray(strained_time, dtype=float))
         shifts, pieces = self._arrays
         weights = float(scaled_epsilon) ** np.arange(len(self.terms))
-        piece_index = np.searchsorted(weights @ shifts, folded)
         result = np.zeros(folded.shape + (len(pieces[0]),))
+        piece_index = np.searchsorted(weights @ shifts, folded) if len(pieces) > 1 else None
         for piece, components in enumerate(pieces):
-            mask = piece_index == piece
-            if not np.any(mask):
-                continue
-            points = folded[mask]
+            if piece_index is None:  # one piece (smooth f, or no contact): no masks
+                mask, points = ..., folded
+            else:
+                mask = piece_index == piece
+                if not np.any(mask):
+                    continue
+                points = folded[mask]
             for component, groups in enumerate(components):
                 values = sum((_evaluate_terms(*group[:3], weights @ group[3], points, derivative) for group in groups), np.zeros(points.shape))
                 result[mask, component] = values * sign[mask] if derivative else values

@@ -9,7 +9,7 @@ Read off the coefficients the expansion already has (ω_0 … ω_{n+1}):
   singularity of ω(ε) at ε_g, and beyond it every order makes the value worse.  The terms
   are compared in pairs (the last two kept and the next one against the two before), which
   is robust to the interleaved analytic and non-analytic terms of the gauge ε^{1/2};
-* over time the waveform's error is dominated by the phase drift |ω_{n+1} η^{n+1}| t, so
+* over time the waveform's error is dominated by the phase drift δω t (δω the first neglected terms), so
   ``u(t)`` is meaningless once that reaches one radian.
 
 :func:`series_warning` and :func:`phase_warning` return the text of an
@@ -62,16 +62,18 @@ def series_warning(coefficients: Sequence[float], last: int, eta: np.ndarray, ga
     return None
 
 
-def phase_warning(next_coefficient: float, next_power: int, eta: float, times: np.ndarray) -> str | None:
-    """The phase drift |ω_{n+1} η^{n+1}| t reaches one radian at some of ``times``: the waveform is meaningless there."""
+def phase_warning(drift_rate: float, times: np.ndarray) -> str | None:
+    """The phase drift δω t (``drift_rate`` δω: the first neglected terms of the frequency used) reaches one radian
+    at some of ``times``: the waveform is meaningless there."""
     if times.size == 0:
         return None
-    drift = abs(float(next_coefficient)) * abs(eta) ** next_power * float(np.max(np.abs(times)))
+    latest = float(np.max(np.abs(times)))
+    drift = abs(float(drift_rate)) * latest
     if not drift < 1.0:
         return (
-            f"at t = {float(np.max(np.abs(times))):.3g} the phase error of the truncated frequency, "
-            f"|omega_{next_power}| eta^{next_power} t = {drift:.3g} rad, is not small: the waveform holds on "
-            "t << 1/|omega_next eta^next| only; use a higher order, a smaller eps or lindstedt.reference_solution"
+            f"at t = {latest:.3g} the phase error of the truncated frequency, (first neglected terms of omega) t = "
+            f"{drift:.3g} rad, is not small: the waveform holds on t << {1 / max(abs(float(drift_rate)), 1e-300):.3g} "
+            "only; use a higher order, a smaller eps or lindstedt.reference_solution"
         )
     return None
 

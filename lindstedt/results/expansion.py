@@ -468,17 +468,31 @@ class Expansion:
 
         return self._cached("branches", values, compute)
 
+    def _at_epsilon(self, epsilon: float, values: Mapping[Any, Any] | None) -> tuple[float, float, str | None, float]:
+        """Per ε (cached): the gauge η, the frequency ω through ω_{n+1}, the series' warning (or None) and the
+        phase drift rate |ω_{n+2} η^{n+2}| (the frequency is used through ω_{n+1})."""
+
+        def compute() -> tuple[float, float, str | None, float]:
+            gauge = float(self._gauge_values(epsilon))
+            last = self._steps * self.order
+            coefficients = self._frequency_coefficients(last + 2, values)
+            frequency = float(np.polynomial.polynomial.polyval(gauge, coefficients[: last + 2]))
+            message = series_warning(coefficients[: last + 2], last, np.array([gauge]), str(self.gauge))
+            return gauge, frequency, message, abs(float(coefficients[last + 2])) * abs(gauge) ** (last + 2)
+
+        # one slot per values: repeated evaluations at one ε hit it, a sweep over ε does not grow the cache
+        key = ("at", self._values_key(values))
+        cached = self._float_cache.get(key)
+        if cached is None or cached[0] != epsilon:
+            cached = self._float_cache[key] = (epsilon, compute())
+        return cached[1]
+
     def _evaluate(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None, derivative: bool) -> Any:
         scale, amplitude, branches = self._float_branches(values)
-        gauge = float(self._gauge_values(float(epsilon)))
-        last = self._steps * self.order
-        coefficients = self._frequency_coefficients(last + 1, values)
-        frequency = float(np.polynomial.polynomial.polyval(gauge, coefficients))
+        gauge, frequency, message, drift = self._at_epsilon(float(epsilon), values)
         times = np.asarray(t, dtype=float)
-        drift = self._frequency_coefficients(last + 2, values)[last + 2]  # ω is used through ω_{n+1}: it drifts with ω_{n+2}
-        message = series_warning(coefficients, last, np.array([gauge]), str(self.gauge)) or phase_warning(
-            drift, last + 2, gauge, times
-        )
+        if message is None:
+            message = phase_warning(drift, times)
         if message:
             warnings.warn(ExpansionValidityWarning(message), stacklevel=3)
         strained = times * frequency

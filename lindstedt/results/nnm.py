@@ -189,7 +189,7 @@ class NNMExpansion:
         times = np.asarray(t, dtype=float)
         last = len(self.omega) - 1
         message = series_warning(self._coefficients, last, np.array([eta]), self._gauge_name) or phase_warning(
-            self._coefficients[-1], last + 1, eta, times
+            abs(self._coefficients[-1]) * abs(eta) ** (last + 1), times
         )
         if message:
             warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
