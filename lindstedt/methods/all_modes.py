@@ -22,19 +22,20 @@ and u_k = O(ε), k ≠ j, on [0, 1/ε]: that case is the NNM of mode j
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Sequence
 
 import numpy as np
 
 from .._errors import ProblemError
+from ..export.json import JsonExport
 from ..problems.system import UnilateralSystem
 
 __all__ = ["AllModesFirstOrder", "all_modes_first_order"]
 
 
 @dataclass(frozen=True)
-class AllModesFirstOrder:
+class AllModesFirstOrder(JsonExport):
     """First-order frequency corrections λ_k¹ when all modes are excited.
 
     Attributes
@@ -56,7 +57,13 @@ class AllModesFirstOrder:
     averaging_time : float
     samples : int
         Cost counter: forcing samples used by the averages.
+    system : UnilateralSystem
+        The system (exported exactly, as :meth:`UnilateralSystem.to_json_dict`).
+
+    JSON schema ``lindstedt.all-modes-first-order/1`` (:meth:`to_json`).
     """
+
+    SCHEMA = "lindstedt.all-modes-first-order/1"
 
     lambdas: tuple[float, ...]
     amplitudes: tuple[float, ...]
@@ -67,6 +74,7 @@ class AllModesFirstOrder:
     message: str
     averaging_time: float
     samples: int
+    system: UnilateralSystem | None = field(default=None, repr=False, compare=False)
 
     def frequency(self, epsilon: float) -> np.ndarray:
         """λ_k^ε = λ_k + ε λ_k¹ for every mode."""
@@ -148,4 +156,5 @@ def all_modes_first_order(
         message=message,
         averaging_time=float(total_time),
         samples=int(long_times.size) if gapped else 0,
+        system=system,
     )

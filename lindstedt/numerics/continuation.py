@@ -258,6 +258,7 @@ def _drive(stepper: _Stepper, start: float, stop: float, max_points: int,
             points=tuple(points), parameter_values=np.array(values, dtype=float), folds=folds,
             stability_changes=stability, contact_changes=contact, flow_evaluations=problem.flow_evaluations,
             newton_iterations=iterations, rejected_steps=rejected, wall_time=time.perf_counter() - started,
+            system=problem.system,
         )
 
     def notify(index: int, value: float, result: NNMResult) -> bool:

@@ -75,6 +75,7 @@ import numpy as np
 import scipy.linalg
 
 from .._errors import ProblemError
+from ..export.json import JsonExport
 from ..problems.system import UnilateralSystem
 from .switching import _Bracket, _Counters, _first_exit, _SearchFailure
 
@@ -97,7 +98,7 @@ _CLUSTER_RTOL = 1e-9
 # results
 # --------------------------------------------------------------------------- #
 @dataclass(frozen=True)
-class SwitchEvent:
+class SwitchEvent(JsonExport):
     """A switch of one unilateral spring.
 
     Attributes
@@ -110,7 +111,11 @@ class SwitchEvent:
     direction : int
         +1 when the spring engages (``g`` becomes positive), −1 when it releases
         (for :func:`smooth_flow`: the sign of the event function's slope).
+
+    JSON schema ``lindstedt.switch-event/1`` (:meth:`to_json`).
     """
+
+    SCHEMA = "lindstedt.switch-event/1"
 
     time: float
     spring: int
@@ -118,7 +123,7 @@ class SwitchEvent:
 
 
 @dataclass(frozen=True)
-class FlowResult:
+class FlowResult(JsonExport):
     """Trajectory returned by :meth:`ExactFlow.solve` and :func:`smooth_flow`.
 
     Attributes
@@ -151,7 +156,17 @@ class FlowResult:
     contact_states : tuple of tuple of int
         Distinct contact states visited, in order of first visit, each given by
         its engaged springs.
+    system : UnilateralSystem or None
+        The system flowed (:meth:`ExactFlow.solve`; None for :func:`smooth_flow`,
+        whose right-hand side is a function).  Exported exactly, as
+        :meth:`UnilateralSystem.to_json_dict`.
+    epsilon : float or None
+        ε of the flow (:meth:`ExactFlow.solve`).
+
+    JSON schema ``lindstedt.flow/1`` (:meth:`to_json`; the dense output is not exported).
     """
+
+    SCHEMA = "lindstedt.flow/1"
 
     success: bool
     message: str
@@ -167,6 +182,8 @@ class FlowResult:
     n_decompositions: int
     contact_states: tuple[tuple[int, ...], ...]
     _evaluator: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] = field(repr=False, compare=False)
+    system: UnilateralSystem | None = field(default=None, repr=False, compare=False)
+    epsilon: float | None = field(default=None, repr=False, compare=False)
 
     @property
     def n_states_visited(self) -> int:
@@ -197,7 +214,7 @@ class FlowResult:
 
 
 @dataclass(frozen=True)
-class FlowMapResult:
+class FlowMapResult(JsonExport):
     """Result of :meth:`ExactFlow.flow_map`.
 
     Attributes
@@ -210,7 +227,15 @@ class FlowMapResult:
         ``∂(X(t), X'(t)) / ∂(X0, V0)`` when requested.
     n_switches, n_root_solves, n_arcs, n_evaluations : int
         Cost counters as in :class:`FlowResult`.
+    system : UnilateralSystem or None
+        The system flowed (exported exactly).
+    epsilon : float or None
+        ε of the flow.
+
+    JSON schema ``lindstedt.flow-map/1`` (:meth:`to_json`).
     """
+
+    SCHEMA = "lindstedt.flow-map/1"
 
     success: bool
     message: str
@@ -221,6 +246,8 @@ class FlowMapResult:
     n_root_solves: int
     n_arcs: int
     n_evaluations: int
+    system: UnilateralSystem | None = field(default=None, repr=False, compare=False)
+    epsilon: float | None = field(default=None, repr=False, compare=False)
 
 
 # --------------------------------------------------------------------------- #
@@ -738,6 +765,8 @@ class ExactFlow:
             n_decompositions=run["decompositions"],
             contact_states=run["visited"],
             _evaluator=evaluator,
+            system=self.system,
+            epsilon=self.epsilon,
         )
 
     def flow_map(self, x0: Any, v0: Any, t: float, *, sensitivity: bool = False) -> FlowMapResult:
@@ -761,4 +790,6 @@ class ExactFlow:
             velocity=run["v"],
             sensitivity=run["jacobian"],
             **run["cost"],
+            system=self.system,
+            epsilon=self.epsilon,
         )

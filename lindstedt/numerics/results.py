@@ -6,7 +6,9 @@ energy, Floquet multipliers (eigenvalues of the monodromy matrix) and the cost
 of the computation; a failure carries its reason and is never raised.  A
 continuation returns an :class:`NNMBranch` (points in branch order, folds,
 stability and contact changes) and reports its progress as
-:class:`ContinuationProgress`.
+:class:`ContinuationProgress`.  All three export themselves to JSON through
+:mod:`lindstedt.export.json` (schemas ``lindstedt.nnm-numeric/1``,
+``lindstedt.nnm-branch/1``, ``lindstedt.continuation-progress/1``).
 
 Examples
 --------
@@ -18,18 +20,19 @@ Examples
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from ..export.json import JsonExport, finite_float, to_jsonable
+
 __all__ = ["ContinuationProgress", "NNMBranch", "NNMResult"]
 
 
 @dataclass(frozen=True)
-class NNMResult:
+class NNMResult(JsonExport):
     """One nonlinear normal mode (a periodic orbit), or why it could not be computed.
 
     Attributes
@@ -79,7 +82,13 @@ class NNMResult:
         Flow integrations used, including the verification flow.
     monodromy : numpy.ndarray or None
         The 2N × 2N monodromy matrix.
+    system : UnilateralSystem
+        The system the orbit belongs to (kept, not written into ``nnm-numeric/1``).
+
+    JSON schema ``lindstedt.nnm-numeric/1`` (:meth:`to_dict`, documented key by key).
     """
+
+    SCHEMA = "lindstedt.nnm-numeric/1"
 
     success: bool
     message: str
@@ -101,6 +110,7 @@ class NNMResult:
     newton_iterations: int
     flow_evaluations: int
     monodromy: np.ndarray | None = field(default=None, repr=False)
+    system: Any = field(default=None, repr=False, compare=False)  # the UnilateralSystem it was computed for
 
     @property
     def contact(self) -> bool:
@@ -124,38 +134,35 @@ class NNMResult:
         (True, 'converged', 1.006128)
         """
 
-        def number(value: Any) -> float | None:
-            return float(value) if math.isfinite(value) else None
+        def vector(values: Any) -> list[float | None]:
+            return to_jsonable(np.asarray(values, dtype=float).reshape(-1))
 
-        multipliers = [] if self.floquet_multipliers is None else [[number(z.real), number(z.imag)] for z in self.floquet_multipliers]
+        multipliers = (
+            [] if self.floquet_multipliers is None
+            else to_jsonable(np.asarray(self.floquet_multipliers, dtype=complex).reshape(-1))
+        )
         return {
-            "schema": "lindstedt.nnm-numeric/1",
+            "schema": self.SCHEMA,
             "success": bool(self.success),
             "status": "converged" if self.success else "failed",
             "message": self.message,
             "mode": self.mode,
-            "epsilon": number(self.epsilon),
-            "frequency": number(self.frequency),
-            "period": number(self.period),
-            "linear_frequency": number(self.linear_frequency),
-            "release_position": [number(x) for x in self.release_position],
-            "release_velocity": [number(x) for x in self.release_velocity],
-            "modal_coordinates": [number(x) for x in self.modal_coordinates],
-            "energy": number(self.energy),
+            "epsilon": finite_float(self.epsilon),
+            "frequency": finite_float(self.frequency),
+            "period": finite_float(self.period),
+            "linear_frequency": finite_float(self.linear_frequency),
+            "release_position": vector(self.release_position),
+            "release_velocity": vector(self.release_velocity),
+            "modal_coordinates": vector(self.modal_coordinates),
+            "energy": finite_float(self.energy),
             "floquet_multipliers": multipliers,
             "stable": self.stable,
-            "residual": number(self.residual),
+            "residual": finite_float(self.residual),
             "n_switches": self.n_switches,
             "formulation": self.formulation,
             "newton_iterations": self.newton_iterations,
             "flow_evaluations": self.flow_evaluations,
         }
-
-    def to_json(self, indent: int | None = 2) -> str:
-        """Strict JSON text of :meth:`to_dict` (never NaN)."""
-        import json
-
-        return json.dumps(self.to_dict(), indent=indent, allow_nan=False)
 
     def summary(self) -> str:
         """One line: mode, ε, ω, T, energy, stability, cost."""
@@ -171,7 +178,7 @@ class NNMResult:
 
 
 @dataclass(frozen=True)
-class ContinuationProgress:
+class ContinuationProgress(JsonExport):
     """Passed to the continuation callback after every accepted point.
 
     Attributes
@@ -186,7 +193,12 @@ class ContinuationProgress:
         Current step (arclength for "arclength", parameter increment otherwise).
     flow_evaluations : int
         Flows used so far by the whole continuation.
+
+    JSON schema ``lindstedt.continuation-progress/1`` (:meth:`to_json`; the
+    point as its ``lindstedt.nnm-numeric/1`` dictionary).
     """
+
+    SCHEMA = "lindstedt.continuation-progress/1"
 
     index: int
     parameter: float
@@ -196,7 +208,7 @@ class ContinuationProgress:
 
 
 @dataclass(frozen=True)
-class NNMBranch:
+class NNMBranch(JsonExport):
     """A branch of NNMs from a continuation.
 
     Attributes
@@ -228,8 +240,15 @@ class NNMBranch:
     rejected_steps : int
         Steps that failed and were retried with a smaller step.
     wall_time : float
+    system : UnilateralSystem
+        The system of the branch (exported as its JSON dictionary).
         Seconds.
+
+    JSON schema ``lindstedt.nnm-branch/1`` (:meth:`to_json`; every point as
+    its ``lindstedt.nnm-numeric/1`` dictionary).
     """
+
+    SCHEMA = "lindstedt.nnm-branch/1"
 
     success: bool
     stop_reason: str
@@ -244,6 +263,7 @@ class NNMBranch:
     newton_iterations: int
     rejected_steps: int
     wall_time: float
+    system: Any = field(default=None, repr=False, compare=False)  # the UnilateralSystem it was computed for
 
     def __len__(self) -> int:
         return len(self.points)

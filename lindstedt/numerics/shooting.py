@@ -487,7 +487,7 @@ class NNMShooting:
             modal_coordinates=self.projector @ x0, energy=nnm_energy(self.system, x0, v0, epsilon),
             floquet_multipliers=multipliers, stable=stable, residual=residual, n_switches=trajectory.n_switches,
             mode_share=share, formulation=label, newton_iterations=iterations,
-            flow_evaluations=self.flow_evaluations, monodromy=monodromy,
+            flow_evaluations=self.flow_evaluations, monodromy=monodromy, system=self.system,
         )
 
     def _failure(self, epsilon: float, message: str, iterations: int = 0, *, label: str | None = None,
@@ -502,6 +502,7 @@ class NNMShooting:
             release_velocity=np.full(n, np.nan), modal_coordinates=np.full(n, np.nan), energy=nan,
             floquet_multipliers=None, stable=None, residual=nan, n_switches=0, mode_share=nan,
             formulation=label or self.formulation, newton_iterations=iterations, flow_evaluations=self.flow_evaluations,
+            system=self.system,
         )
 
     def _solve(self, z0: np.ndarray, epsilon: float, amplitude: _Amplitude | None = None, *, tol: float,

@@ -13,13 +13,15 @@ fits ``log(μ_ε(T)/T)`` against ``log ε`` on the true solutions
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 import scipy.optimize
 
 from .._errors import ProblemError
+from ..export.json import JsonExport
+from ..problems.oscillator import Oscillator
 from ..results.expansion import Expansion
 from .errors import _as_epsilons, _fit_or_nan
 from .solutions import _as_positive, _numeric_problem, _require_expansion, reference_solution
@@ -28,7 +30,7 @@ __all__ = ["ContactMeasure", "contact_measure", "ContactMeasureFit", "fitted_con
 
 
 @dataclass(frozen=True)
-class ContactMeasure:
+class ContactMeasure(JsonExport):
     """``μ(T) = |{t ∈ [t_0, T] : min_j |u(t) − b_j| ≤ threshold}|``.
 
     Attributes
@@ -53,7 +55,13 @@ class ContactMeasure:
         Grid points.
     n_refined : int
         Band edges located by Brent's method on the dense output (0 for samples).
+
+    Measured on given samples or a given function: it has no problem (the
+    fit :class:`ContactMeasureFit` carries its).  JSON schema
+    ``lindstedt.contact-measure/1`` (:meth:`to_json`).
     """
+
+    SCHEMA = "lindstedt.contact-measure/1"
 
     success: bool
     message: str
@@ -210,7 +218,7 @@ def contact_measure(
 
 
 @dataclass(frozen=True)
-class ContactMeasureFit:
+class ContactMeasureFit(JsonExport):
     """Slope of ``log(μ_ε(T)/T)`` against ``log ε`` on true solutions.
 
     Attributes
@@ -229,7 +237,13 @@ class ContactMeasureFit:
         The breakpoints b_j of f.
     n_reference_solves, n_samples, n_refined, n_switches : int
         Totals.
+    problem : Oscillator
+        The problem of the expansion (exported as its description).
+
+    JSON schema ``lindstedt.contact-measure-fit/1`` (:meth:`to_json`).
     """
+
+    SCHEMA = "lindstedt.contact-measure-fit/1"
 
     success: bool
     message: str
@@ -246,6 +260,7 @@ class ContactMeasureFit:
     n_samples: int
     n_refined: int
     n_switches: int
+    problem: Oscillator | None = field(default=None, repr=False, compare=False)
 
 
 def fitted_contact_measure_order(
@@ -345,4 +360,5 @@ def fitted_contact_measure_order(
         n_samples=n * len(eps_values),
         n_refined=n_refined,
         n_switches=n_switches,
+        problem=expansion.problem,
     )

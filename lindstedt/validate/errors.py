@@ -42,13 +42,15 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
 from .._errors import ProblemError
+from ..export.json import JsonExport
 from ..results.accuracy import ExpansionValidityWarning
+from ..problems.oscillator import Oscillator
 from ..results.expansion import Expansion
 from .solutions import (
     DEFAULT_ATOL,
@@ -82,7 +84,7 @@ _ROUNDING_FLOOR = 1e3 * np.finfo(float).eps
 # log-log fits
 # --------------------------------------------------------------------------- #
 @dataclass(frozen=True)
-class LogLogFit:
+class LogLogFit(JsonExport):
     """Least-squares line ``log y = slope · log x + intercept``.
 
     Attributes
@@ -94,7 +96,12 @@ class LogLogFit:
         with r the residuals of the logarithms; NaN for two points.
     n_points : int
         Number of points fitted.
+
+    A pure fit of numbers: it has no problem (the fits of the validation
+    functions carry theirs).  JSON schema ``lindstedt.loglog-fit/1``.
     """
+
+    SCHEMA = "lindstedt.loglog-fit/1"
 
     slope: float
     intercept: float
@@ -152,7 +159,7 @@ def _as_epsilons(epsilons: Sequence[float]) -> np.ndarray:
 # expansion error
 # --------------------------------------------------------------------------- #
 @dataclass(frozen=True)
-class ExpansionError:
+class ExpansionError(JsonExport):
     """``e(t) = u_N(t) − u(t)`` on a uniform grid of ``[0, t_end]``.
 
     Attributes
@@ -180,7 +187,13 @@ class ExpansionError:
         How u was computed (see :class:`ReferenceSolution`).
     n_samples, n_switches, n_evaluations : int
         Grid size and the reference's counters.
+    problem : Oscillator
+        The problem of the expansion (exported as its description).
+
+    JSON schema ``lindstedt.expansion-error/1`` (:meth:`to_json`).
     """
+
+    SCHEMA = "lindstedt.expansion-error/1"
 
     success: bool
     message: str
@@ -197,6 +210,7 @@ class ExpansionError:
     n_samples: int
     n_switches: int
     n_evaluations: int
+    problem: Oscillator | None = field(default=None, repr=False, compare=False)
 
 
 def _approximation(expansion: Expansion, epsilon: float, times: np.ndarray, values: Mapping[Any, Any] | None,
@@ -316,6 +330,7 @@ def expansion_error(
         n_samples=n,
         n_switches=reference.n_switches,
         n_evaluations=reference.n_evaluations,
+        problem=expansion.problem,
     )
 
 
@@ -363,7 +378,7 @@ def _t_end_function(rule: str | Callable[[float], float], constant: float) -> tu
 
 
 @dataclass(frozen=True)
-class ConvergenceFit:
+class ConvergenceFit(JsonExport):
     """Slope of ``log max_{[0, t_end(ε)]} |u_N − u|`` against ``log ε``.
 
     Attributes
@@ -384,7 +399,13 @@ class ConvergenceFit:
         How the windows were chosen.
     n_reference_solves, n_samples, n_switches, n_evaluations : int
         Totals over the ε values.
+    problem : Oscillator
+        The problem of the expansion (exported as its description).
+
+    JSON schema ``lindstedt.convergence-fit/1`` (:meth:`to_json`).
     """
+
+    SCHEMA = "lindstedt.convergence-fit/1"
 
     success: bool
     message: str
@@ -400,6 +421,7 @@ class ConvergenceFit:
     n_samples: int
     n_switches: int
     n_evaluations: int
+    problem: Oscillator | None = field(default=None, repr=False, compare=False)
 
 
 def fitted_convergence_order(
@@ -485,6 +507,7 @@ def fitted_convergence_order(
         t_ends=np.array(t_ends),
         t_end_rule=rule_name,
         **runs.totals(),
+        problem=expansion.problem,
     )
 
 
@@ -492,7 +515,7 @@ def fitted_convergence_order(
 # validity exponent
 # --------------------------------------------------------------------------- #
 @dataclass(frozen=True)
-class ValidityFit:
+class ValidityFit(JsonExport):
     """Exponent p of the validity time ``T_ε ~ ε^p``.
 
     ``T_ε`` is the first time the phase-plane error ``ρ(t)`` exceeds
@@ -520,7 +543,13 @@ class ValidityFit:
         The last window searched for each ε.
     n_reference_solves, n_samples, n_switches, n_evaluations : int
         Totals.
+    problem : Oscillator
+        The problem of the expansion (exported as its description).
+
+    JSON schema ``lindstedt.validity-fit/1`` (:meth:`to_json`).
     """
+
+    SCHEMA = "lindstedt.validity-fit/1"
 
     success: bool
     message: str
@@ -538,6 +567,7 @@ class ValidityFit:
     n_samples: int
     n_switches: int
     n_evaluations: int
+    problem: Oscillator | None = field(default=None, repr=False, compare=False)
 
 
 def _first_exceedance(times: np.ndarray, values: np.ndarray, threshold: float) -> float | None:
@@ -696,4 +726,5 @@ def fitted_validity_exponent(
         thresholds=np.array(thresholds),
         horizons=np.array(horizons),
         **errors_on.totals(),
+        problem=expansion.problem,
     )

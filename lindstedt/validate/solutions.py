@@ -36,6 +36,7 @@ import sympy
 from scipy.integrate import solve_ivp
 
 from .._errors import ProblemError, UnsupportedNonlinearityError
+from ..export.json import JsonExport
 from ..results.expansion import Expansion
 from ..numerics.flow import ExactFlow, FlowResult
 from ..numerics.smooth import smooth_flow
@@ -159,7 +160,7 @@ def _initial_displacement(source: Oscillator | Expansion, numeric: _NumericProbl
 # reference solution
 # --------------------------------------------------------------------------- #
 @dataclass(frozen=True)
-class ReferenceSolution:
+class ReferenceSolution(JsonExport):
     """The true solution of ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = u0``, ``u'(0) = 0``.
 
     Attributes
@@ -183,7 +184,14 @@ class ReferenceSolution:
         Gap-function evaluations (exact flow) or right-hand-side evaluations (DOP853).
     n_arcs : int
         Closed-form arcs or DOP853 restarts.
+    problem : Oscillator
+        The problem solved (exported as its description).
+
+    JSON schema ``lindstedt.reference-solution/1`` (:meth:`to_json`; the
+    dense output is not exported).
     """
+
+    SCHEMA = "lindstedt.reference-solution/1"
 
     success: bool
     message: str
@@ -198,6 +206,7 @@ class ReferenceSolution:
     n_evaluations: int
     n_arcs: int
     _evaluator: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] = field(repr=False, compare=False)
+    problem: Oscillator | None = field(default=None, repr=False, compare=False)
 
     def state(self, t: Any) -> tuple[np.ndarray, np.ndarray]:
         """Dense output: ``(u(t), u'(t))`` for any times in ``[0, t_final]``, shaped like ``t``."""
@@ -402,6 +411,7 @@ def reference_solution(
         n_evaluations=int(outcome.n_evaluations),
         n_arcs=int(outcome.n_arcs),
         _evaluator=outcome.evaluator,
+        problem=_problem_of(source),
     )
 
 
@@ -409,7 +419,7 @@ def reference_solution(
 # exact period
 # --------------------------------------------------------------------------- #
 @dataclass(frozen=True)
-class ExactPeriod:
+class ExactPeriod(JsonExport):
     """Exact period of the true solution.
 
     Attributes
@@ -424,7 +434,13 @@ class ExactPeriod:
         Dense-output evaluations used by Brent's method.
     reference_method : str
         How the true solution was computed.
+    problem : Oscillator
+        The problem solved (exported as its description).
+
+    JSON schema ``lindstedt.exact-period/1`` (:meth:`to_json`).
     """
+
+    SCHEMA = "lindstedt.exact-period/1"
 
     success: bool
     message: str
@@ -432,6 +448,7 @@ class ExactPeriod:
     half_period: float
     n_root_evaluations: int
     reference_method: str
+    problem: Oscillator | None = field(default=None, repr=False, compare=False)
 
 
 def exact_period(
@@ -472,7 +489,7 @@ def exact_period(
 
     if start_sign == 0 or changes.size == 0:
         return ExactPeriod(False, "u' has no positive zero within two linear periods (rest state or too large ε?)",
-                           math.nan, math.nan, counter[0], reference.method)
+                           math.nan, math.nan, counter[0], reference.method, problem=_problem_of(source))
     k = int(changes[0]) + 1
     half = float(scipy.optimize.brentq(speed, grid[k - 1], grid[k], xtol=1e-15, rtol=4 * np.finfo(float).eps))
     return ExactPeriod(
@@ -482,4 +499,5 @@ def exact_period(
         half_period=half,
         n_root_evaluations=counter[0],
         reference_method=reference.method,
+        problem=_problem_of(source),
     )

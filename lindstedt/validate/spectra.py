@@ -29,12 +29,13 @@ exact period (:func:`lindstedt.validate.exact_period`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any, Mapping, Sequence
 
 import numpy as np
 
 from .._errors import ProblemError
+from ..export.json import JsonExport
 from ..results.expansion import Expansion
 from ..problems.oscillator import Oscillator
 from .solutions import (
@@ -57,7 +58,7 @@ _LOG_FLOOR = -300.0
 
 
 @dataclass(frozen=True)
-class SpectralPeak:
+class SpectralPeak(JsonExport):
     """One line of the spectrum.
 
     Attributes
@@ -72,7 +73,12 @@ class SpectralPeak:
         One-sided amplitude (``|c_0|`` for the mean, ``|c_k − i s_k|`` otherwise).
     log10_relative : float
         ``log10(amplitude / largest amplitude)``.
+
+    A line of a :class:`Spectrum` (whose problem it shares).  JSON schema
+    ``lindstedt.spectral-peak/1`` (:meth:`to_json`).
     """
+
+    SCHEMA = "lindstedt.spectral-peak/1"
 
     label: int | None
     bin: int
@@ -82,7 +88,7 @@ class SpectralPeak:
 
 
 @dataclass(frozen=True)
-class Spectrum:
+class Spectrum(JsonExport):
     """One-sided amplitude spectrum of uniformly sampled data.
 
     Attributes
@@ -111,7 +117,15 @@ class Spectrum:
         Number of fundamental periods in the window, when known.
     n_samples : int
         Samples transformed.
+    problem : Oscillator or None
+        The problem whose solution (or expansion) was sampled; None for
+        :func:`spectrum` of given samples.  Exported as its description.
+
+    JSON schema ``lindstedt.spectrum/1`` (:meth:`to_json`; complex
+    coefficients as ``[real, imag]`` pairs).
     """
+
+    SCHEMA = "lindstedt.spectrum/1"
 
     success: bool
     message: str
@@ -125,6 +139,7 @@ class Spectrum:
     duration: float
     periods: float | None
     n_samples: int
+    problem: Oscillator | None = field(default=None, repr=False, compare=False)
 
     @property
     def harmonic_numbers(self) -> np.ndarray:
@@ -292,8 +307,8 @@ def _window_times(duration: float, periods: int, samples_per_period: int) -> np.
     return np.arange(n) * (duration / n)
 
 
-def _with_message(result: Spectrum, prefix: str, success: bool = True) -> Spectrum:
-    return replace(result, message=prefix + result.message, success=result.success and success)
+def _with_message(result: Spectrum, prefix: str, success: bool = True, problem: Oscillator | None = None) -> Spectrum:
+    return replace(result, message=prefix + result.message, success=result.success and success, problem=problem)
 
 
 def expansion_spectrum(
@@ -335,7 +350,8 @@ def expansion_spectrum(
     times = _window_times(duration, periods, samples_per_period)
     samples = np.asarray(expansion.displacement(times, float(epsilon), values), dtype=float)
     result = spectrum(samples, duration, periods=periods, peak_floor=peak_floor)
-    return _with_message(result, f"expansion of order {expansion.order} at ε = {epsilon:g}, ω = {omega:.15g}; ")
+    return _with_message(result, f"expansion of order {expansion.order} at ε = {epsilon:g}, ω = {omega:.15g}; ",
+                         problem=expansion.problem)
 
 
 def exact_spectrum(
@@ -369,4 +385,4 @@ def exact_spectrum(
     reference = reference_solution(source, epsilon, times, values=values, a1=a1, rtol=rtol, atol=atol)
     result = spectrum(reference.displacement, duration, periods=periods, peak_floor=peak_floor)
     prefix = f"exact solution of {problem.describe()} at ε = {epsilon:g}, P = {period.period:.16g}; "
-    return _with_message(result, prefix, reference.success and period.success)
+    return _with_message(result, prefix, reference.success and period.success, problem=problem)
