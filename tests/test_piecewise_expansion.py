@@ -203,8 +203,9 @@ def test_piecewise_waveform_error_scales_like_eps_to_order_plus_one(order):
 
 
 def test_bad_piecewise_inputs():
-    with pytest.raises(lindstedt.UnsupportedNonlinearityError, match="jumps"):
-        lindstedt.expand("Heaviside(u - 1/2)", order=1, a0=1, omega0=1)
+    # a force that jumps (Heaviside(u - 1/2)) is supported since issue 12 (tests/test_jumps.py); nesting is not
+    with pytest.raises(lindstedt.UnsupportedNonlinearityError, match="nested"):
+        lindstedt.expand("Max(0, Max(0, u) - 1/2)", order=1, a0=1, omega0=1)
     with pytest.raises(lindstedt.UnsupportedNonlinearityError, match="piecewise linear"):
         lindstedt.expand("Max(0, u)**2", order=1, a0=1, omega0=1)
     with pytest.raises(lindstedt.ProblemError, match="sign of a0"):

@@ -1,13 +1,15 @@
-"""Continuous piecewise-linear nonlinearities f(u), e.g. unilateral springs a·(u − b)_+.
+"""Piecewise-linear nonlinearities f(u): unilateral springs a·(u − b)_+ and forces that jump, c·H(u − b).
 
-Any continuous piecewise-linear f can be written with breakpoints
-``u_1 < … < u_n`` and one linear function ``f(u) = λ_j u + μ_j`` on each of
-the n + 1 intervals.  :func:`decompose_piecewise_linear` finds that form from
-an expression written with ``Max``/``Min``/``Abs``/``Heaviside``/``sign``
-(``a*Max(0, u - b)``, ``a*(u - b)*Heaviside(u - b)``, sums of several springs
-on either side, ``Max(0, -u - b)`` for a spring acting on negative
-displacements), checks continuity, and refuses anything else with a message
-that names what is supported.
+Any piecewise-linear f can be written with breakpoints ``u_1 < … < u_n`` and
+one linear function ``f(u) = λ_j u + μ_j`` on each of the n + 1 intervals.
+:func:`decompose_piecewise_linear` finds that form from an expression written
+with ``Max``/``Min``/``Abs``/``Heaviside``/``sign`` (``a*Max(0, u - b)``,
+``a*(u - b)*Heaviside(u - b)``, sums of several springs on either side,
+``Max(0, -u - b)`` for a spring acting on negative displacements, and
+``c*Heaviside(u - b)``, ``sign(u)``: a force that jumps at the breakpoint), and
+refuses anything else with a message that names what is supported.  A jump is
+allowed: u stays C¹ across it (u'' jumps), which is all the branch hierarchy's
+matching needs.
 """
 
 from __future__ import annotations
@@ -22,8 +24,8 @@ __all__ = ["LinearInterval", "decompose_piecewise_linear"]
 
 _SWITCHING = (sympy.Max, sympy.Min, sympy.Abs, sympy.Heaviside, sympy.sign)
 _SUPPORTED = (
-    "supported non-smooth f: continuous piecewise-linear sums such as a*Max(0, u - b), "
-    "a*(u - b)*Heaviside(u - b), Max(0, -u - b), Abs(u - b), plus linear terms"
+    "supported non-smooth f: piecewise-linear sums such as a*Max(0, u - b), "
+    "a*(u - b)*Heaviside(u - b), Max(0, -u - b), Abs(u - b), c*Heaviside(u - b), sign(u), plus linear terms"
 )
 
 
@@ -76,7 +78,7 @@ def _branch_value(atom: sympy.Expr, sign_of_argument: int) -> sympy.Expr:
 
 
 def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[LinearInterval]:
-    """Split a continuous piecewise-linear f(u) into linear intervals.
+    """Split a piecewise-linear f(u) (continuous, or jumping at its breakpoints) into linear intervals.
 
     Returns
     -------
@@ -86,9 +88,8 @@ def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[Li
     Raises
     ------
     UnsupportedNonlinearityError
-        For a non-linear piece, a jump (e.g. a pure Heaviside force), nested
-        switches, Max/Min of more than two arguments, or breakpoints whose
-        order cannot be decided (several symbolic gaps).
+        For a non-linear piece, nested switches, Max/Min of more than two
+        arguments, or breakpoints whose order cannot be decided (several symbolic gaps).
 
     Examples
     --------
@@ -96,6 +97,8 @@ def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[Li
     >>> u, b = sympy.Symbol("u", real=True), sympy.Symbol("b", real=True)
     >>> [(i.slope, i.intercept) for i in decompose_piecewise_linear(2*sympy.Max(0, u - b), u)]
     [(0, 0), (2, -2*b)]
+    >>> [(i.slope, i.intercept) for i in decompose_piecewise_linear(sympy.Heaviside(u), u)]   # a jump at 0
+    [(0, 0), (0, 1)]
     """
     atoms = _switching_atoms(f)
     switching: list[tuple[sympy.Expr, sympy.Expr]] = []  # (atom, argument whose sign decides it)
@@ -156,12 +159,4 @@ def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[Li
         lower = unique[index - 1] if index > 0 else None
         upper = unique[index] if index < len(unique) else None
         intervals.append(LinearInterval(lower, upper, sympy.simplify(slope), sympy.simplify(intercept)))
-    for left, right in zip(intervals, intervals[1:]):
-        point = left.upper
-        jump = sympy.simplify((right.slope - left.slope) * point + right.intercept - left.intercept)
-        if jump != 0:
-            raise UnsupportedNonlinearityError(
-                f"f = {f} jumps by {jump} at u = {point}: a discontinuous force (e.g. a bare Heaviside) "
-                f"is not supported; {_SUPPORTED}"
-            )
     return intervals

@@ -92,6 +92,16 @@ class _PiecewiseLaw:
     slopes: tuple[float, ...]
     intercepts: tuple[float, ...]
 
+    @property
+    def continuous(self) -> bool:
+        """False when f jumps at a breakpoint (a force c·H(u − b)): only the event-driven integration takes it."""
+        for point, (s0, s1), (c0, c1) in zip(self.breakpoints, zip(self.slopes, self.slopes[1:]),
+                                             zip(self.intercepts, self.intercepts[1:])):
+            left, right = s0 * point + c0, s1 * point + c1
+            if abs(right - left) > 64 * np.finfo(float).eps * max(1.0, abs(left), abs(right)):
+                return False
+        return True
+
     def region(self, u: float, v: float) -> int:
         """Index of the linear piece the motion is in (or entering, on a breakpoint)."""
         index = int(np.searchsorted(self.breakpoints, u, side="right"))
@@ -242,6 +252,8 @@ def _flow_outcome(flow: FlowResult, method: str, message: str, n_switches: int,
 def _exact_piecewise_flow(law: _PiecewiseLaw, omega0: float, epsilon: float, u0: float,
                           t_end: float) -> tuple[FlowResult, float]:
     """ExactFlow of the shifted system; returns the flow and the shift c (u = x + c)."""
+    if not law.continuous:
+        raise ProblemError("f jumps at a breakpoint, which no spring of the exact flow represents")
     stiffness = omega0**2 + epsilon * law.slopes[0]
     if not stiffness > 0:
         raise ProblemError(f"ω0² + ε λ_0 = {stiffness} is not positive")
