@@ -10,13 +10,16 @@ Accepted grammar (``^`` is read as ``**``)::
 
     expr    := expr ('+' | '-' | '*' | '/' | '**') expr | ('+' | '-') expr | '(' expr ')'
              | NUMBER | NAME | FUNCTION '(' expr (',' expr)* ')'
+             | 'Piecewise' '(' piece (',' piece)* ')'
+    piece   := '(' expr ',' expr ('<' | '<=' | '>' | '>=') expr ')' | '(' expr ',' 'True' ')'   (True: last piece only)
     NUMBER  := integer or decimal literal (``3``, ``0.25``, ``1e-3``, ``1_000``), read exactly
     NAME    := 'u' | a declared parameter | 'pi' | 'E'
     FUNCTION:= sin cos tan sinh cosh tanh asin acos atan exp log sqrt
                Abs abs Max max Min min Heaviside sign
 
 Nothing else: no strings, bytes or f-strings, no attribute access, subscripts,
-keywords, lambdas, comprehensions, comparisons or assignment expressions.
+keywords, lambdas, comprehensions or assignment expressions; comparisons and
+tuples only as the (value, condition) pieces of ``Piecewise``, one comparison each.
 
 Bounds (checked *before* the work they protect is done; the error names the bound):
 :data:`LIMITS` — input length, number of syntax nodes, nesting depth, length of a
@@ -100,6 +103,13 @@ ALLOWED_FUNCTIONS: dict[str, tuple[Callable[..., sympy.Expr], int, int]] = {
     "min": (sympy.Min, 1, 16),
     "Heaviside": (sympy.Heaviside, 1, 1),
     "sign": (sympy.sign, 1, 1),
+    "Piecewise": (sympy.Piecewise, 1, 16),  # built by _Builder.piecewise from (value, condition) pieces
+}
+_COMPARISONS: dict[type, Callable[[Any, Any], Any]] = {
+    ast.Lt: lambda left, right: left < right,
+    ast.LtE: lambda left, right: left <= right,
+    ast.Gt: lambda left, right: left > right,
+    ast.GtE: lambda left, right: left >= right,
 }
 CONSTANTS: dict[str, sympy.Expr] = {"pi": sympy.pi, "E": sympy.E}
 
@@ -262,6 +272,8 @@ class _Builder:
         function, least, most = ALLOWED_FUNCTIONS[node.func.id]
         if not least <= len(node.args) <= most:
             raise self.fail(f"{node.func.id} takes {least if least == most else f'{least} to {most}'} argument(s)")
+        if function is sympy.Piecewise:
+            return self.piecewise(node, depth)
         arguments = [self.build(argument, depth + 1) for argument in node.args]
         if function in _EXPONENTIAL and arguments[0].is_number and not abs(sympy.N(arguments[0], 15)) <= _EXPONENTIAL_ARGUMENT:
             raise ProblemError(
@@ -276,6 +288,35 @@ class _Builder:
             if magnitude.has(sympy.nan, sympy.zoo, sympy.oo) or magnitude > _LARGEST:
                 raise ProblemError(f"{self.what} = {self.text!r}: {node.func.id}{tuple(arguments)} is not a finite number of moderate size")
         return result
+
+    def piecewise(self, node: ast.Call, depth: int) -> sympy.Expr:
+        """``Piecewise((value, u < b), …, (value, True))``: each piece a 2-tuple of an expression and one comparison
+        (``True`` only for the last piece); nothing else of the comparison/tuple syntax is accepted."""
+        pieces = []
+        for position, argument in enumerate(node.args):
+            if not isinstance(argument, ast.Tuple) or len(argument.elts) != 2:
+                raise self.fail("each Piecewise argument must be a pair (value, condition), e.g. (u, u > 0)")
+            value_node, condition_node = argument.elts
+            value = self.build(value_node, depth + 2)
+            if isinstance(condition_node, ast.Constant) and condition_node.value is True:
+                if position != len(node.args) - 1:
+                    raise self.fail("only the last Piecewise piece may have the condition True")
+                condition = sympy.true
+            elif (
+                isinstance(condition_node, ast.Compare)
+                and len(condition_node.ops) == 1
+                and type(condition_node.ops[0]) in _COMPARISONS
+            ):
+                left = self.build(condition_node.left, depth + 3)
+                right = self.build(condition_node.comparators[0], depth + 3)
+                condition = _COMPARISONS[type(condition_node.ops[0])](left, right)
+            else:
+                raise self.fail("a Piecewise condition must be one comparison (<, <=, >, >=) such as u > 0, or True (last piece)")
+            pieces.append((value, condition))
+        try:
+            return sympy.Piecewise(*pieces)
+        except (TypeError, ValueError) as error:
+            raise self.fail(f"Piecewise{tuple(pieces)} cannot be formed ({error})") from None
 
 
 def parse_expression(

@@ -22,10 +22,11 @@ from .._errors import UnsupportedNonlinearityError
 
 __all__ = ["LinearInterval", "decompose_piecewise_linear"]
 
-_SWITCHING = (sympy.Max, sympy.Min, sympy.Abs, sympy.Heaviside, sympy.sign)
+_SWITCHING = (sympy.Max, sympy.Min, sympy.Abs, sympy.Heaviside, sympy.sign, sympy.Piecewise)
 _SUPPORTED = (
     "supported non-smooth f: piecewise-linear sums such as a*Max(0, u - b), "
-    "a*(u - b)*Heaviside(u - b), Max(0, -u - b), Abs(u - b), c*Heaviside(u - b), sign(u), plus linear terms"
+    "a*(u - b)*Heaviside(u - b), Max(0, -u - b), Abs(u - b), c*Heaviside(u - b), sign(u), "
+    "Piecewise((linear, u < b), ..., (linear, True)), plus linear terms"
 )
 
 
@@ -77,6 +78,19 @@ def _branch_value(atom: sympy.Expr, sign_of_argument: int) -> sympy.Expr:
     return second if sign_of_argument > 0 else first
 
 
+def _piece_at(atom: sympy.Piecewise, variable: sympy.Symbol, point: sympy.Expr, f: sympy.Expr) -> sympy.Expr:
+    """The value of the first piece of ``atom`` whose condition holds at ``point`` (strictly inside an interval)."""
+    for value, condition in atom.args:
+        holds = condition.subs(variable, point)
+        if holds not in (sympy.true, sympy.false):
+            holds = sympy.simplify(holds)
+        if holds is sympy.true:
+            return value
+        if holds is not sympy.false:
+            raise UnsupportedNonlinearityError(f"f = {f}: cannot decide the Piecewise condition {condition} between breakpoints")
+    raise UnsupportedNonlinearityError(f"f = {f}: the Piecewise {atom} is undefined between breakpoints (add a last piece (…, True))")
+
+
 def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[LinearInterval]:
     """Split a piecewise-linear f(u) (continuous, or jumping at its breakpoints) into linear intervals.
 
@@ -102,10 +116,13 @@ def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[Li
     """
     atoms = _switching_atoms(f)
     switching: list[tuple[sympy.Expr, sympy.Expr]] = []  # (atom, argument whose sign decides it)
+    piecewise: list[sympy.Piecewise] = []  # decided by their conditions, each a comparison linear in u
     for atom in atoms:
         if any(_switching_atoms(argument) for argument in atom.args):
             raise UnsupportedNonlinearityError(f"f = {f}: nested switching functions are not supported; {_SUPPORTED}")
-        if isinstance(atom, (sympy.Max, sympy.Min)):
+        if isinstance(atom, sympy.Piecewise):
+            piecewise.append(atom)
+        elif isinstance(atom, (sympy.Max, sympy.Min)):
             if len(atom.args) != 2:
                 raise UnsupportedNonlinearityError(f"f = {f}: Max/Min must have exactly two arguments; {_SUPPORTED}")
             switching.append((atom, atom.args[0] - atom.args[1]))
@@ -119,6 +136,16 @@ def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[Li
             raise UnsupportedNonlinearityError(f"f = {f}: a switch whose argument does not depend on u; {_SUPPORTED}")
         breakpoints.append(-offset / slope)
         slopes.append(slope)
+    for atom in piecewise:
+        for _, condition in atom.args:
+            if condition is sympy.true:
+                continue
+            if not isinstance(condition, (sympy.StrictLessThan, sympy.LessThan, sympy.StrictGreaterThan, sympy.GreaterThan)):
+                raise UnsupportedNonlinearityError(f"f = {f}: the Piecewise condition {condition} is not one comparison; {_SUPPORTED}")
+            slope, offset = _linear_argument(condition.lhs - condition.rhs, variable, f)
+            if slope == 0:
+                raise UnsupportedNonlinearityError(f"f = {f}: the Piecewise condition {condition} does not depend on u")
+            breakpoints.append(-offset / slope)
     unique: list[sympy.Expr] = []
     for point in breakpoints:
         if not any(sympy.simplify(point - other) == 0 for other in unique):
@@ -151,6 +178,8 @@ def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[Li
             if sign_value not in (1, -1):
                 raise UnsupportedNonlinearityError(f"f = {f}: cannot decide the sign of {argument} between breakpoints")
             replacements[atom] = _branch_value(atom, int(sign_value))
+        for atom in piecewise:
+            replacements[atom] = _piece_at(atom, variable, point, f)
         piece = sympy.expand(f.xreplace(replacements))
         if piece.has(*_SWITCHING) or not piece.is_polynomial(variable) or sympy.degree(piece, variable) > 1:
             raise UnsupportedNonlinearityError(f"f = {f} is not piecewise linear in u (piece {piece}); {_SUPPORTED}")
