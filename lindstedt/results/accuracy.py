@@ -18,11 +18,13 @@ Read off the coefficients the expansion already has (ω_0 … ω_{n+1}):
 
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
-__all__ = ["ExpansionValidityWarning", "branch_bound", "displacement_error", "phase_warning", "series_warning"]
+from .._errors import ParameterError
+
+__all__ = ["ExpansionValidityWarning", "branch_bound", "displacement_error", "gauge_values", "phase_warning", "series_warning"]
 
 
 class ExpansionValidityWarning(UserWarning):
@@ -99,3 +101,17 @@ def displacement_error(amplitude: float, frequency_error: float, times: np.ndarr
     the frequency used) plus ``neglected_term``, the size of the first neglected waveform term (the callers take
     the last kept one, |a0| η̂^n max|W_n|, times η̂)."""
     return abs(amplitude) * abs(frequency_error) * np.abs(times) + neglected_term
+
+
+def gauge_values(epsilon: Any, steps: int, negative_hint: str) -> np.ndarray:
+    """The gauge η at ε: ε itself (``steps`` = 1) or √ε (``steps`` = 2, which holds for ε ≥ 0 only: the perturbed
+    orbit crosses the grazing breakpoint for ε > 0; ``negative_hint`` says what to use for ε < 0)."""
+    points = np.asarray(epsilon, dtype=float)
+    if steps == 1:
+        return points
+    if np.any(points < 0):
+        raise ParameterError(
+            "this expansion is in powers of sqrt(epsilon) (a grazing breakpoint that the perturbed orbit passes): "
+            f"it holds for epsilon >= 0; for epsilon < 0 {negative_hint}"
+        )
+    return np.sqrt(points)

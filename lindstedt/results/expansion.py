@@ -43,7 +43,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 import sympy
 
-from .accuracy import ExpansionValidityWarning, branch_bound, displacement_error, phase_warning, series_warning
+from .accuracy import ExpansionValidityWarning, branch_bound, displacement_error, gauge_values, phase_warning, series_warning
 from .assumptions import DerivationAssumptions, shown_values
 from .._errors import OrderError, ParameterError
 from ..algebra.branch import Branch, EvaluationPoint
@@ -416,16 +416,10 @@ class Expansion:
 
     def _gauge_values(self, epsilon: Any) -> np.ndarray:
         """The gauge at ε (ε itself, or √ε: then ε must not be negative)."""
-        points = np.asarray(epsilon, dtype=float)
-        if self._steps == 1:
-            return points
-        if np.any(points < 0):
-            raise ParameterError(
-                "this expansion is in powers of sqrt(epsilon): it holds for epsilon >= 0, where the perturbed orbit "
-                "crosses the grazing breakpoint; for epsilon < 0 the orbit stays on its side and the frequency is "
-                "analytic (use lindstedt.reference_solution, or expand the problem with f replaced by -f for -epsilon)"
-            )
-        return np.sqrt(points)
+        return gauge_values(
+            epsilon, self._steps, "the orbit stays on its side and the frequency is analytic: use "
+            "lindstedt.reference_solution, or expand the problem with f replaced by -f at -epsilon"
+        )
 
     @cached_property
     def _float_cache(self) -> dict[Any, Any]:

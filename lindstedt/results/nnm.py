@@ -18,9 +18,8 @@ import mpmath
 import numpy as np
 import sympy
 
-from .._errors import ProblemError
 from ..engine.branches import BranchHierarchy, FloatBranches
-from .accuracy import ExpansionValidityWarning, branch_bound, displacement_error, phase_warning, series_warning
+from .accuracy import ExpansionValidityWarning, branch_bound, displacement_error, gauge_values, phase_warning, series_warning
 from ..problems.nnm import NNMProblem
 from ..problems.system import UnilateralSystem
 
@@ -167,15 +166,7 @@ class NNMExpansion:
         return np.array([float(w) for w in self.omega] + [float(next_value)])
 
     def _gauge_values(self, epsilon: Any) -> np.ndarray:
-        points = np.asarray(epsilon, dtype=float)
-        if self.gauge == 1:
-            return points
-        if np.any(points < 0):
-            raise ProblemError(
-                "this NNM is expanded in powers of sqrt(epsilon) (a grazing spring that the perturbed orbit passes): "
-                "it holds for epsilon >= 0; for epsilon < 0 use lindstedt.nnm_point"
-            )
-        return np.sqrt(points)
+        return gauge_values(epsilon, self.gauge, "use lindstedt.nnm_point")
 
     def modal_displacement(self, t: Any, epsilon: float) -> np.ndarray:
         """Modal coordinates U(t) ≈ a0 Σ_{n<N} ε̂^n W_n(ω t), ω through ω_N (shape ``t.shape + (N_dof,)``).
