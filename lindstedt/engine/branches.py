@@ -289,6 +289,9 @@ class BranchHierarchy(LazyOrders):
         self._lag = int(any(boundary.grazing for boundary in system.boundaries))
         self._derivatives: dict[tuple[int, int, int, int], Branch] = {}
         self._resonant = Branch(domain, {(1, 1, 1): domain.one / domain.convert(2)})  # s sin s / 2 solves v'' + v = cos s
+        self._resonant_slope = self._resonant.derivative()
+        # r_k as domain elements (the mode component's frequency is 1)
+        self._ratio_elements = [domain.one if ratio is None else ratio for ratio in system.ratios]
         self.counters = {"orders": 0}
 
     # -- read access ---------------------------------------------------------------------------------
@@ -400,39 +403,39 @@ class BranchHierarchy(LazyOrders):
                 components.append(rhs.oscillator_particular_solution(system.ratios[k]))
             particular.append(components)
 
+        # the particular solutions' slopes, each formed once per order (they are evaluated at every boundary)
+        particular_slopes = [[branch.derivative() for branch in components] for components in particular]
+        ratios = self._ratio_elements
+
         def value_of(piece: int, k: int, c: _Affine, d: _Affine, point: EvaluationPoint, slope: bool) -> _Affine:
             """W_{n,k}^piece (or its slope) at point, for homogeneous parts c, d."""
             frequency = system.frequency(k)
-            ratio = one if system.ratios[k] is None else system.ratios[k]
             cosine, sine = point.cos_multiple(frequency), point.sin_multiple(frequency)
-            branch = particular[piece][k].derivative() if slope else particular[piece][k]
+            branch = particular_slopes[piece][k] if slope else particular[piece][k]
             result = constant(branch.evaluate(point))
             if k == mode:
-                result = result + unit(0).scale((resonant.derivative() if slope else resonant).evaluate(point))
+                result = result + unit(0).scale((self._resonant_slope if slope else resonant).evaluate(point))
             if slope:
-                return result + c.scale(-sine * ratio) + d.scale(cosine * ratio)
+                return result + c.scale(-sine * ratios[k]) + d.scale(cosine * ratios[k])
             return result + c.scale(cosine) + d.scale(sine)
 
         # First piece: c_k free, d_k from W_k'(0) = 0 (d_k r_k + slope without d = 0).
         c_values = [[unit(1 + k) for k in range(size)]]
-        d_values = []
-        first = []
-        for k in range(size):
-            slope_without_d = value_of(0, k, c_values[0][k], constant(zero), system.zero_point, True)
-            ratio = one if system.ratios[k] is None else system.ratios[k]
-            first.append(slope_without_d.scale(-one / ratio))
-        d_values.append(first)
-        shift_values: list[_Affine] = []
+        d_values = [[value_of(0, k, c_values[0][k], constant(zero), system.zero_point, True).scale(-one / ratios[k])
+                     for k in range(size)]]
+        shift_values: list[_Affine | None] = []
         for index, boundary in enumerate(system.boundaries):
             point = boundary.point
             powers = self._shift_powers(index, order)
             left, right = index, index + 1
+            # W_{n,k} on the left piece at β, and its known Taylor terms there (W_order and σ_order excluded)
+            values = [value_of(left, k, c_values[left][k], d_values[left][k], point, False) for k in range(size)]
+            known = [self._known(index, left, k, order, 0, powers) for k in range(size)]
             # Contact: Σ_k c_k W_k(s*) = κ  ->  order n: Σ_k c_k [W_{n,k}(β) + known_k] + c_j W_0'(β) σ_n = 0, W_0' = −sin β.
             gap = constant(zero)
             for k, coupling in enumerate(boundary.coupling):
                 if coupling:
-                    value = value_of(left, k, c_values[left][k], d_values[left][k], point, False)
-                    gap = gap + value.shift(self._known(index, left, k, order, 0, powers)).scale(coupling)
+                    gap = gap + values[k].shift(known[k]).scale(coupling)
             if not boundary.grazing:
                 shift_values.append(gap.scale(one / (boundary.coupling[mode] * boundary.sine)))
             elif order >= 3:
@@ -445,17 +448,15 @@ class BranchHierarchy(LazyOrders):
             # C¹ matching of every component: the homogeneous parts of the right piece.
             c_next, d_next = [], []
             for k in range(size):
-                value = value_of(left, k, c_values[left][k], d_values[left][k], point, False)
                 slope = value_of(left, k, c_values[left][k], d_values[left][k], point, True)
-                x = value.shift(self._known(index, left, k, order, 0, powers) - self._known(index, right, k, order, 0, powers))
+                x = values[k].shift(known[k] - self._known(index, right, k, order, 0, powers))
                 y = slope.shift(self._known(index, left, k, order, 1, powers) - self._known(index, right, k, order, 1, powers))
                 x = x - value_of(right, k, constant(zero), constant(zero), point, False)
                 y = y - value_of(right, k, constant(zero), constant(zero), point, True)
                 frequency = system.frequency(k)
-                ratio = one if system.ratios[k] is None else system.ratios[k]
                 cosine, sine = point.cos_multiple(frequency), point.sin_multiple(frequency)
-                c_next.append(x.scale(cosine) - y.scale(sine / ratio))
-                d_next.append(x.scale(sine) + y.scale(cosine / ratio))
+                c_next.append(x.scale(cosine) - y.scale(sine / ratios[k]))
+                d_next.append(x.scale(sine) + y.scale(cosine / ratios[k]))
             c_values.append(c_next)
             d_values.append(d_next)
         last = len(system.states) - 1

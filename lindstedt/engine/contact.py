@@ -240,15 +240,15 @@ def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hi
         interval_of.append(current)
     form = _assemble(problem, w_intervals, interval_of, crossing_kappas, (), grazing, classes, sign, digits, order_hint)
     crossed = []
+    first_order = BranchHierarchy(form.system, problem.normalization).branches(1) if grazing else None
     for kappa in grazing:
         # The orbit's turning point w0 = κ = ±1 touches the breakpoint: does the order-one orbit pass it?
         # The gap W − κ near β has the double root of W_0 plus ε̂ W_1(β): with η = ε̂^{1/2} and s* = β + σ_1 η + …,
         # W_1(β) + W_0''(β) σ_1²/2 = 0, W_0''(β) = −κ, so σ_1² = 2 W_1(β)/κ: a real crossing iff σ_1² > 0.
         top = kappa > 0
-        hierarchy = BranchHierarchy(form.system, problem.normalization)
         piece = 0 if top else len(form.system.states) - 1
         point = form.system.zero_point if top else form.system.pi_point
-        squared = 2 * form.to_expr(hierarchy.branches(1)[piece][0].evaluate(point)) / kappa
+        squared = 2 * form.to_expr(first_order[piece][0].evaluate(point)) / kappa
         if squared.is_positive:
             interval = kappas.index(kappa) + (1 if top else 0)
             crossed.append((kappa, interval, (1 if top else -1) * sympy.sqrt(squared)))

@@ -171,18 +171,25 @@ class LindstedtPoincare:
             if not self.numeric:  # the problem's numbers are exact (the parser reads floats exactly)
                 # Exact: the normal form does not depend on the order; it is built only on a miss
                 # (its domain has fresh Dummy generators and must not enter the key).
-                key, build_form = (problem_key, "piecewise", None), lambda: contact_normal_form(problem, None)
+                key, make_form = (problem_key, "piecewise", None), lambda: contact_normal_form(problem, None)
             else:
                 # Float: the working digits (precision + guard digits near grazing, which grow with
                 # the order) decide the hierarchy; the float normal form is cheap, build it to know them.
                 form = contact_normal_form(problem, self.precision, order_hint=order + 1)
-                key, build_form = (problem_key, "piecewise", form.domain.dps), lambda: form
-            return _CACHE.get(key, lambda: _with_form(build_form(), lambda form: BranchHierarchy(form.system, problem.normalization)))
+                key, make_form = (problem_key, "piecewise", form.domain.dps), lambda: form
+
+            def build() -> tuple[Any, Any]:
+                built = make_form()
+                return built, BranchHierarchy(built.system, problem.normalization)
+
+            return _CACHE.get(key, build)
         digits = None if problem.is_polynomial else self.precision
-        return _CACHE.get(
-            (problem_key, "smooth", digits),
-            lambda: _with_form(normal_form(problem, self.precision), lambda form: SmoothHierarchy(form, problem.normalization)),
-        )
+
+        def build_smooth() -> tuple[Any, Any]:
+            built = normal_form(problem, self.precision)
+            return built, SmoothHierarchy(built, problem.normalization)
+
+        return _CACHE.get((problem_key, "smooth", digits), build_smooth)
 
     def expand(self, problem: Oscillator, order: int):
         """Lindstedt–Poincaré expansion of ``problem`` to ``order``.
@@ -195,10 +202,6 @@ class LindstedtPoincare:
         validate_order(order)
         form, hierarchy = self.hierarchy(problem, order)
         return Expansion(problem=problem, order=order, _hierarchy=hierarchy, _form=form)
-
-
-def _with_form(form: Any, build: Callable[[Any], Any]) -> tuple[Any, Any]:
-    return form, build(form)
 
 
 def validate_order(order: Any) -> int:
