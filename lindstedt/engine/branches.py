@@ -25,7 +25,7 @@ Conditions: ``W_k'(0) = 0`` and ``W_k'(π) = 0`` (even, 2π-periodic); C¹
 matching of every component at every moving boundary and the contact condition
 ``Σ_k c_ik W_k(s_i*) = κ_i`` — Taylor-expanded about β_i, so values and
 integrals with moving limits are closed forms; and one normalisation of the
-mode component: ``W_{n,j}(0) = δ_{n1} w_1`` ("initial", the release) or zero
+mode component: ``W_{n,j}(0) = w_n`` ("initial", the release series) or zero
 first harmonic of the exact ``W_j`` including the moving-boundary terms
 ("harmonic").  ``W_j'(π) = 0`` is the secular (Fredholm) condition that fixes
 ``A_n``; for k ≠ j it fixes the periodic solution, which exists iff r_k ∉ ℤ.
@@ -87,7 +87,8 @@ class BranchSystem:
     ``ratios[k] = r_k`` (``None`` for the mode component j, whose frequency is 1
     and whose solves use the exact rational kernel); ``states`` has one entry per
     piece of [0, π], ``boundaries`` one per crossing, increasing in angle;
-    ``release`` is ``w_1``, the ε̂-coefficient of W_j(0) under the "initial" normalisation.
+    ``release`` is ``(w_1, w_2, …)``, the ε̂-coefficients of W_j(0) under the "initial" normalisation
+    (shorter tuples mean zeros beyond).
     ``gauge`` is 1 for expansions in η = ε̂ and 2 for η = ε̂^{1/2} (a grazing boundary is
     crossed): the laws and the release then enter at order 2 in η.
     """
@@ -99,8 +100,13 @@ class BranchSystem:
     boundaries: tuple[MovingBoundary, ...]
     zero_point: EvaluationPoint
     pi_point: EvaluationPoint
-    release: Any
+    release: tuple[Any, ...]
     gauge: int = 1
+
+    def release_at(self, order: int) -> Any | None:
+        """The prescribed W_{order,j}(0) in the gauge's powers (None: zero)."""
+        step, remainder = divmod(order, self.gauge)
+        return self.release[step - 1] if not remainder and 1 <= step <= len(self.release) and self.release[step - 1] else None
 
     @property
     def size(self) -> int:
@@ -463,7 +469,8 @@ class BranchHierarchy(LazyOrders):
         equations = [value_of(last, k, c_values[last][k], d_values[last][k], system.pi_point, True) for k in range(size)]
         if self.normalization == "initial":
             release = value_of(0, mode, c_values[0][mode], d_values[0][mode], system.zero_point, False)
-            equations.append(release.shift(-system.release) if order == system.gauge else release)
+            prescribed = system.release_at(order)
+            equations.append(release if prescribed is None else release.shift(-prescribed))
         else:
             equations.append(self._first_harmonic_condition(order, particular, c_values, d_values, unit(0)))
         unknowns = solve_linear([list(e.coefficients) for e in equations], [-e.base for e in equations], domain, order)

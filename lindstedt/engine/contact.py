@@ -286,8 +286,9 @@ def _assemble(
     for kappa in crossing_kappas:
         values += [kappa, sympy.acos(kappa), _contact_sine(kappa)]
     values += [item[2] for item in crossed]
-    release = problem.a1 * problem.omega0**2 / problem.a0  # u(0) = a0 (1 + ε̂ W_1(0)), ε̂ = ε/ω0²
-    values.append(release)
+    # u(0) = a0 (1 + Σ ε̂^n W_n(0)), ε̂ = ε/ω0²
+    releases = [shift * problem.omega0 ** (2 * n) / problem.a0 for n, shift in enumerate(problem.release_shifts, 1)]
+    values += releases
     numeric = digits is not None or any(value.has(sympy.Float) for value in values)
     if numeric:
         digits = (digits or 30) + _guard_digits(crossing_kappas, order_hint)
@@ -322,7 +323,7 @@ def _assemble(
         boundaries=tuple(moving),
         zero_point=zero,
         pi_point=pi_point,
-        release=field.convert(release),
+        release=tuple(field.convert(release) for release in releases),
         gauge=gauge,
     )
     if grazing:

@@ -199,7 +199,7 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
             boundaries=tuple(boundaries),
             zero_point=zero_point,
             pi_point=pi_point,
-            release=convert(release_correction) * lam * lam / a0,
+            release=(convert(release_correction) * lam * lam / a0,),
             gauge=2 if crossed else 1,
         )
 

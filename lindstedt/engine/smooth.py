@@ -82,7 +82,7 @@ class NormalForm:
     taylor_series: Callable[[int], CosineSeries | None]
     prune_tolerance: float | None
     degree: int | None
-    release: Any = None  # w_1(0): the shift a1 of the release point u(0) = a0 + ε a1, in normalised units a1/(a0 q_L)
+    release: tuple = ()  # (w_1(0), w_2(0), …): the release u(0) = a0 + Σ ε^n a_n in normalised units a_n/(a0 q_L^n)
     # What a result reads of every normal form (the piecewise one has contact boundaries instead):
     regime: ClassVar[str] = "smooth"
     validity_exponent: ClassVar[sympy.Integer] = sympy.Integer(-1)
@@ -127,11 +127,16 @@ def _polynomial_normal_form(problem: Oscillator) -> NormalForm:
             generator = sympy.Dummy(f"rho{power}")
             generators.append((generator, ratio))
             ratios[power] = generator
-    release = sympy.cancel(problem.a1 / (amplitude * lead))  # u(0) = a0 (1 + ε̂ w_1(0)) with ε̂ = q_L ε
-    release_generator = None
-    if not release.is_Rational:
-        release_generator = sympy.Dummy("w10")
-        generators.append((release_generator, release))
+    # u(0) = a0 (1 + Σ ε̂^n w_n(0)) with ε̂ = q_L ε
+    releases = [sympy.cancel(shift / (amplitude * lead**n)) for n, shift in enumerate(problem.release_shifts, 1)]
+    release_generators: list[sympy.Expr] = []
+    for n, release in enumerate(releases, 1):
+        if release.is_Rational:
+            release_generators.append(release)
+        else:
+            generator = sympy.Dummy(f"w{n}0")
+            generators.append((generator, release))
+            release_generators.append(generator)
     domain = QQ if not generators else QQ[tuple(symbol for symbol, _ in generators)]
     ratio_elements = {power: domain.convert(value) if value.is_Rational else domain.from_sympy(value) for power, value in ratios.items()}
     powers = _cosine_powers(domain, degree)
@@ -152,8 +157,8 @@ def _polynomial_normal_form(problem: Oscillator) -> NormalForm:
             )
         return cache[order]
 
-    release_element = domain.convert(release) if release_generator is None else domain.from_sympy(release_generator)
-    return NormalForm(domain, lead, tuple(generators), taylor_series, None, degree, release_element)
+    release_elements = tuple(domain.convert(value) if value.is_Rational else domain.from_sympy(value) for value in release_generators)
+    return NormalForm(domain, lead, tuple(generators), taylor_series, None, degree, release_elements)
 
 
 def _analytic_normal_form(problem: Oscillator, digits: int) -> NormalForm:
@@ -180,7 +185,7 @@ def _analytic_normal_form(problem: Oscillator, digits: int) -> NormalForm:
         cache[order] = _chebyshev_cosine_series(function, domain, digits, tolerance, problem)
         return cache[order]
 
-    release = domain.from_sympy(sympy.Float(problem.a1 / amplitude, digits + 10))
+    release = tuple(domain.from_sympy(sympy.Float(shift / amplitude, digits + 10)) for shift in problem.release_shifts)
     return NormalForm(domain, sympy.Integer(1), (), taylor_series, tolerance, None, release)
 
 
@@ -376,7 +381,7 @@ class SmoothHierarchy(LazyOrders):
             if self.form.prune_tolerance is not None:
                 right_hand_side = right_hand_side - CosineSeries.cosine(self._domain, 1, right_hand_side.coefficient(1))
             if self.normalization == "initial":
-                release = self.form.release if k == 1 and self.form.release else self._domain.zero
+                release = self.form.release[k - 1] if k <= len(self.form.release) else self._domain.zero
                 solution = solve_harmonic_oscillator(right_hand_side, self._domain.one, value_at_zero=release)
             else:
                 solution = solve_harmonic_oscillator(right_hand_side, self._domain.one, first_harmonic=self._domain.zero)

@@ -212,6 +212,11 @@ class Oscillator:
         return tuple(symbol for symbol, value in self.params if value == symbol)
 
     @property
+    def release_shifts(self) -> tuple[sympy.Expr, ...]:
+        """``(a1, a2, …)`` of the release point ``u(0) = a0 + Σ ε^n a_n`` (empty: released at a0 exactly)."""
+        return (self.a1,) if self.a1 != 0 else ()
+
+    @property
     def free_symbols(self) -> set[sympy.Symbol]:
         """Symbols a numeric evaluation must be given: a0, ω0 or parameters left symbolic."""
         symbols = set(self.nonlinearity.free_symbols) - {DISPLACEMENT}
