@@ -11,7 +11,7 @@ hierarchy expand a contact boundary that moves with ε).  This module gives the
 exact calculus of such branches with coefficients in any sympy domain
 (``QQ``, a fraction field ``QQ(π, β, …)``, ``RealField``):
 
-* sums, scalar multiples, derivatives, products with ``cos(n s)``;
+* sums, scalar multiples, derivatives, products (of branches with integer harmonics);
 * evaluation at a point whose ``cos(j s0)``, ``sin(j s0)`` are known
   (:class:`EvaluationPoint`, using the Chebyshev recurrences from cos s0, sin s0);
 * exact antiderivatives (integration by parts, memoised over ``QQ``);
@@ -259,6 +259,38 @@ class Branch:
             if harmonic:
                 factor = convert(harmonic) if isinstance(harmonic, int) else harmonic
                 _add_into(result, (harmonic, 1 - parity, power), value * factor if parity else -(value * factor))
+        return Branch(self.domain, result)
+
+    def __mul__(self, other: "Branch") -> "Branch":
+        """Product of two branches with integer harmonics (product-to-sum; powers of s add).
+
+        Examples
+        --------
+        >>> import sympy
+        >>> square = Branch.cosine(sympy.QQ) * Branch.cosine(sympy.QQ)      # cos² s = (1 + cos 2s)/2
+        >>> square.to_expr(sympy.Symbol("s"))
+        cos(2*s)/2 + 1/2
+        """
+        result: dict[TermKey, Any] = {}
+        half = self.domain.convert(QQ(1, 2))
+        for (j, parity, power), value in self.terms.items():
+            for (k, other_parity, other_power), other_value in other.terms.items():
+                if not (isinstance(j, int) and isinstance(k, int)):
+                    raise TypeError("products of branches need integer harmonics")
+                product = value * other_value * half
+                exponent = power + other_power
+                difference = j - k
+                # cos·cos = (cos(j−k) + cos(j+k))/2; sin·sin = (cos(j−k) − cos(j+k))/2;
+                # sin_j·cos_k = (sin(j+k) + sin(j−k))/2; cos_j·sin_k = (sin(j+k) − sin(j−k))/2
+                if parity == other_parity:
+                    _add_into(result, (abs(difference), 0, exponent), product)
+                    _add_into(result, (j + k, 0, exponent), product if parity == 0 else -product)
+                else:
+                    sine_sign = 1 if parity == 1 else -1  # sign of sin(j−k) in the sum
+                    if difference < 0:
+                        sine_sign = -sine_sign
+                    _add_into(result, (j + k, 1, exponent), product)
+                    _add_into(result, (abs(difference), 1, exponent), product if sine_sign > 0 else -product)
         return Branch(self.domain, result)
 
     def times_cosine(self, harmonic: int) -> "Branch":

@@ -17,7 +17,12 @@ with constant coefficients, so every correction is an analytic quasi-
 trigonometric branch (:mod:`lindstedt.algebra.branch`), continued past the
 piece's ends.  With ``Ω² = Σ A_n ε̂^n`` order n reads, component by component,
 
-    W_{n,k}'' + r_k² W_{n,k} = A_n δ_kj cos s − Σ_{i<n} A_i W_{n−i,k}'' − (L_p W_{n−1})_k − δ_{n1} (m_p)_k.
+    W_{n,k}'' + r_k² W_{n,k} = A_n δ_kj cos s − Σ_{i<n} A_i W_{n−i,k}'' − (L_p W_{n−1})_k − δ_{n1} (m_p)_k
+                                − Σ_m c_{p,m} [W^m]_{n−1}      (N = 1, a polynomial contact law)
+
+(``[W^m]_n`` is the ε̂ⁿ coefficient of (Σ ε̂^i W_i)^m: products of branches of lower
+orders on the same piece, still quasi-trigonometric, so a polynomial law on a
+piece keeps every branch analytic and continued past the piece's ends).
 
 Unknowns of order n: ``A_n``, the homogeneous parts ``c cos(r_k s) + d sin(r_k s)``
 of every component on every piece, and the boundary shifts ``σ_{i,n}``.
@@ -52,10 +57,15 @@ __all__ = ["BranchHierarchy", "BranchSystem", "ContactState", "FloatBranches", "
 
 @dataclass(frozen=True)
 class ContactState:
-    """One contact state: the linear law ε̂ (L W + m) on a piece of [0, π] (rows of domain elements)."""
+    """One contact state: the law ε̂ (L W + m + Σ_m c_m W^m) on a piece of [0, π] (rows of domain elements).
+
+    ``powers`` lists ``(m, c_m)``, m ≥ 2, of a polynomial contact law; it acts on a
+    single component (N = 1: the 1-dof oscillator with a piecewise-polynomial f).
+    """
 
     stiffness: tuple[tuple[Any, ...], ...]
     load: tuple[Any, ...]
+    powers: tuple[tuple[int, Any], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -294,6 +304,7 @@ class BranchHierarchy(LazyOrders):
         ]
         self._lag = int(any(boundary.grazing for boundary in system.boundaries))
         self._derivatives: dict[tuple[int, int, int, int], Branch] = {}
+        self._law_powers: dict[tuple[int, int, int], Branch] = {}
         self._resonant = Branch(domain, {(1, 1, 1): domain.one / domain.convert(2)})  # s sin s / 2 solves v'' + v = cos s
         self._resonant_slope = self._resonant.derivative()
         # r_k as domain elements (the mode component's frequency is 1)
@@ -333,6 +344,19 @@ class BranchHierarchy(LazyOrders):
         self._ensure(highest + self._lag)
         shifts = tuple(tuple(to_float(value) for value in self.boundary_shift(n)) for n in range(highest + 1))
         return FloatBranches(terms, shifts)
+
+    def _law_power(self, piece: int, power: int, order: int) -> Branch:
+        """[W^power]_order on ``piece`` (N = 1): Σ_i [W^{power−1}]_i W_{order−i}, memoised."""
+        key = (piece, power, order)
+        if key not in self._law_powers:
+            if power == 1:
+                result = self._branches[order][piece][0]
+            else:
+                result = Branch(self._domain)
+                for i in range(order + 1):
+                    result = result + self._law_power(piece, power - 1, i) * self._branches[order - i][piece][0]
+            self._law_powers[key] = result
+        return self._law_powers[key]
 
     # -- the expansion about a moving boundary -------------------------------------------------------
     def _derivative(self, order: int, piece: int, component: int, times: int) -> Branch:
@@ -406,6 +430,9 @@ class BranchHierarchy(LazyOrders):
                         rhs = rhs - self._branches[order - system.gauge][piece][l].scale(entry)
                 if order == system.gauge and state.load[k]:
                     rhs = rhs - Branch.constant(domain, state.load[k])
+                if order >= system.gauge:
+                    for power, coefficient in state.powers:
+                        rhs = rhs - self._law_power(piece, power, order - system.gauge).scale(coefficient)
                 components.append(rhs.oscillator_particular_solution(system.ratios[k]))
             particular.append(components)
 

@@ -1,10 +1,11 @@
-"""The 1-dof contact normal form: u'' + ω0² u + ε f(u) = 0 with f continuous and piecewise linear.
+"""The 1-dof contact normal form: u'' + ω0² u + ε f(u) = 0 with f piecewise polynomial.
 
 Problem: ``u(0) = a0``, ``u'(0) = 0`` (or a0 the first-harmonic amplitude),
-f a sum of unilateral springs ``a (u − b)_+`` and linear terms.  With
-``w = u/a0``, ``ω = ω0 Ω``, ``ε̂ = ε/ω0²``:
+f a sum of unilateral springs ``a (u − b)_+``, contact laws such as ``(u − b)_+²``
+or ``u|u|``, jumps and polynomial terms: one polynomial ``Σ_m c_m u^m`` between
+consecutive breakpoints.  With ``w = u/a0``, ``ω = ω0 Ω``, ``ε̂ = ε/ω0²``:
 
-    Ω² w'' + w + ε̂ (ℓ_p w + m_p) = 0,   f̂(w) = λ w + μ/a0 on each w-interval,
+    Ω² w'' + w + ε̂ f̂_p(w) = 0,   f̂_p(w) = f_p(a0 w)/a0 = Σ_m c_m a0^{m−1} w^m on each w-interval,
 
 whose breakpoints ``κ_i = u_i/a0`` are crossed by ``w_0 = cos s`` at the
 contact angles ``β_i = arccos κ_i`` when |κ_i| < 1.  This module classifies
@@ -31,7 +32,7 @@ import sympy
 from sympy import QQ, RealField
 
 from .._errors import ProblemError
-from ..problems.piecewise_linear import decompose_piecewise_linear
+from ..problems.piecewise_linear import decompose_piecewise
 from ..problems.oscillator import DISPLACEMENT, Oscillator
 from ..algebra.branch import EvaluationPoint
 from .branches import BranchHierarchy, BranchSystem, ContactState, MovingBoundary
@@ -57,7 +58,7 @@ class PiecewiseNormalForm:
     domain: Any
     epsilon_scale: sympy.Expr
     generator_values: tuple[tuple[sympy.Symbol, sympy.Expr], ...]
-    piece_coefficients: tuple[tuple[Any, Any], ...]  # (ℓ_p, m_p) per piece in s
+    piece_laws: tuple[tuple[Any, ...], ...]  # per piece in s: f̂(w) = Σ_m law[m] w^m
     boundaries: tuple[ContactBoundary, ...]
     grazing: tuple[sympy.Expr, ...]  # breakpoints κ with |κ| = 1
     regime: str  # "contact", "no contact", "grazing"
@@ -188,21 +189,22 @@ def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hi
     numeric case guard digits are added near grazing (see :func:`_guard_digits`)
     so that ``digits`` stay correct up to order ``order_hint``.
     """
-    intervals = decompose_piecewise_linear(problem.nonlinearity, DISPLACEMENT)
+    intervals = decompose_piecewise(problem.nonlinearity, DISPLACEMENT)
     amplitude = problem.a0
     sign = _sign_of_amplitude(amplitude)
-    # w-breakpoints κ_i = u_i / a0, and the linear law f̂(w) = λ w + μ/a0 on each interval.
-    w_intervals: list[tuple[sympy.Expr | None, sympy.Expr | None, sympy.Expr, sympy.Expr]] = []
+    # w-breakpoints κ_i = u_i / a0, and the law f̂(w) = f(a0 w)/a0 = Σ_m c_m a0^{m−1} w^m on each interval.
+    w_intervals: list[tuple[sympy.Expr | None, sympy.Expr | None, tuple[sympy.Expr, ...]]] = []
     for interval in intervals:
         lower = None if interval.lower is None else interval.lower / amplitude
         upper = None if interval.upper is None else interval.upper / amplitude
         if sign < 0:
             lower, upper = upper, lower
-        w_intervals.append((lower, upper, interval.slope, interval.intercept / amplitude))
+        law = tuple(coefficient * amplitude ** (power - 1) for power, coefficient in enumerate(interval.coefficients))
+        w_intervals.append((lower, upper, law))
     if sign < 0:
         w_intervals.reverse()
     # Breakpoints in w, increasing; classify each against the orbit [-1, 1].
-    kappas = [upper for (_, upper, _, _) in w_intervals[:-1]]
+    kappas = [upper for (_, upper, _) in w_intervals[:-1]]
     crossing: list[int] = []
     grazing: list[sympy.Expr] = []
     classes: list[tuple[sympy.Expr, str]] = []
@@ -281,8 +283,7 @@ def _assemble(
     interval_of = [item[1] for item in top] + list(interval_of) + [item[1] for item in bottom]
     values: list[sympy.Expr] = []
     for interval_index in interval_of:
-        _, _, slope, intercept = w_intervals[interval_index]
-        values += [slope, intercept]
+        values += list(w_intervals[interval_index][2])
     for kappa in crossing_kappas:
         values += [kappa, sympy.acos(kappa), _contact_sine(kappa)]
     values += [item[2] for item in crossed]
@@ -294,10 +295,7 @@ def _assemble(
         digits = (digits or 30) + _guard_digits(crossing_kappas, order_hint)
     field = _ConstantField(values, digits)
     domain = field.domain
-    piece_coefficients = []
-    for interval_index in interval_of:
-        _, _, slope, intercept = w_intervals[interval_index]
-        piece_coefficients.append((field.convert(slope), field.convert(intercept)))
+    piece_laws = [tuple(field.convert(value) for value in w_intervals[interval_index][2]) for interval_index in interval_of]
     zero = EvaluationPoint(domain, domain.zero, domain.one, domain.zero)
     pi_point = EvaluationPoint(domain, field.convert(sympy.pi), -domain.one, domain.zero)
     boundaries, moving = [], []
@@ -319,7 +317,10 @@ def _assemble(
         domain=domain,
         ratios=(None,),
         mode=0,
-        states=tuple(ContactState(((slope,),), (intercept,)) for slope, intercept in piece_coefficients),
+        states=tuple(
+            ContactState(((law[1],),), (law[0],), tuple((power, value) for power, value in enumerate(law) if power >= 2 and value))
+            for law in piece_laws
+        ),
         boundaries=tuple(moving),
         zero_point=zero,
         pi_point=pi_point,
@@ -328,7 +329,7 @@ def _assemble(
     )
     if grazing:
         regime = "grazing"
-    elif all(not ell and not m for ell, m in piece_coefficients):
+    elif all(not value for law in piece_laws for value in law):
         regime = "no contact"
     else:
         regime = "contact"
@@ -339,7 +340,7 @@ def _assemble(
         domain=domain,
         epsilon_scale=1 / problem.omega0**2,
         generator_values=tuple(field.generators),
-        piece_coefficients=tuple(piece_coefficients),
+        piece_laws=tuple(piece_laws),
         boundaries=tuple(boundaries),
         grazing=tuple(grazing),
         regime=regime,

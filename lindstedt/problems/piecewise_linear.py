@@ -1,15 +1,17 @@
-"""Piecewise-linear nonlinearities f(u): unilateral springs a·(u − b)_+ and forces that jump, c·H(u − b).
+"""Piecewise-polynomial nonlinearities f(u): unilateral springs a·(u − b)_+, contact laws such as
+(u − b)_+², u|u|, forces that jump, c·H(u − b).
 
-Any piecewise-linear f can be written with breakpoints ``u_1 < … < u_n`` and
-one linear function ``f(u) = λ_j u + μ_j`` on each of the n + 1 intervals.
-:func:`decompose_piecewise_linear` finds that form from an expression written
-with ``Max``/``Min``/``Abs``/``Heaviside``/``sign`` (``a*Max(0, u - b)``,
-``a*(u - b)*Heaviside(u - b)``, sums of several springs on either side,
-``Max(0, -u - b)`` for a spring acting on negative displacements, and
-``c*Heaviside(u - b)``, ``sign(u)``: a force that jumps at the breakpoint), and
-refuses anything else with a message that names what is supported.  A jump is
-allowed: u stays C¹ across it (u'' jumps), which is all the branch hierarchy's
-matching needs.
+Any such f can be written with breakpoints ``u_1 < … < u_n`` and one polynomial
+``f(u) = Σ_m c_{j,m} u^m`` on each of the n + 1 intervals.  :func:`decompose_piecewise`
+finds that form from an expression written with ``Max``/``Min``/``Abs``/``Heaviside``/
+``sign``/``Piecewise`` (``a*Max(0, u - b)``, ``a*(u - b)*Heaviside(u - b)``, sums of
+several springs on either side, ``Max(0, -u - b)`` for a spring acting on negative
+displacements, ``Max(0, u)**2``, ``u*Abs(u)``, ``Heaviside(u)*u**2``, plus any
+polynomial, and ``c*Heaviside(u - b)``, ``sign(u)``: a force that jumps at the
+breakpoint), and refuses anything else with a message that names what is supported.
+A jump is allowed: u stays C¹ across it (u'' jumps), which is all the branch
+hierarchy's matching needs.  :func:`decompose_piecewise_linear` is the degree-one case
+(the exact piecewise-linear flow needs it).
 """
 
 from __future__ import annotations
@@ -20,24 +22,35 @@ import sympy
 
 from .._errors import UnsupportedNonlinearityError
 
-__all__ = ["LinearInterval", "decompose_piecewise_linear"]
+__all__ = ["PolynomialInterval", "decompose_piecewise", "decompose_piecewise_linear"]
 
 _SWITCHING = (sympy.Max, sympy.Min, sympy.Abs, sympy.Heaviside, sympy.sign, sympy.Piecewise)
 _SUPPORTED = (
-    "supported non-smooth f: piecewise-linear sums such as a*Max(0, u - b), "
-    "a*(u - b)*Heaviside(u - b), Max(0, -u - b), Abs(u - b), c*Heaviside(u - b), sign(u), "
-    "Piecewise((linear, u < b), ..., (linear, True)), plus linear terms"
+    "supported non-smooth f: piecewise-polynomial laws such as a*Max(0, u - b), "
+    "a*(u - b)*Heaviside(u - b), Max(0, -u - b), Abs(u - b), Max(0, u - b)**2, u*Abs(u), "
+    "Heaviside(u)*u**2, c*Heaviside(u - b), sign(u), "
+    "Piecewise((polynomial, u < b), ..., (polynomial, True)), plus polynomial terms "
+    "(fractional powers such as the Hertz law Max(0, u)**(3/2) and non-polynomial pieces are not supported yet)"
 )
 
 
 @dataclass(frozen=True)
-class LinearInterval:
-    """f(u) = slope·u + intercept for u between ``lower`` and ``upper`` (None = unbounded)."""
+class PolynomialInterval:
+    """f(u) = Σ_m coefficients[m]·u^m for u between ``lower`` and ``upper`` (None = unbounded)."""
 
     lower: sympy.Expr | None
     upper: sympy.Expr | None
-    slope: sympy.Expr
-    intercept: sympy.Expr
+    coefficients: tuple[sympy.Expr, ...]  # increasing degree, at least (c_0, c_1)
+
+    @property
+    def slope(self) -> sympy.Expr:
+        """c_1 (the whole law on a linear interval is slope·u + intercept)."""
+        return self.coefficients[1]
+
+    @property
+    def intercept(self) -> sympy.Expr:
+        """c_0."""
+        return self.coefficients[0]
 
 
 def _switching_atoms(expression: sympy.Expr) -> list[sympy.Expr]:
@@ -91,19 +104,8 @@ def _piece_at(atom: sympy.Piecewise, variable: sympy.Symbol, point: sympy.Expr, 
     raise UnsupportedNonlinearityError(f"f = {f}: the Piecewise {atom} is undefined between breakpoints (add a last piece (…, True))")
 
 
-def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[LinearInterval]:
-    """Split a piecewise-linear f(u) (continuous, or jumping at its breakpoints) into linear intervals.
-
-    Returns
-    -------
-    list of LinearInterval
-        Ordered by u; consecutive intervals share a breakpoint.
-
-    Raises
-    ------
-    UnsupportedNonlinearityError
-        For a non-linear piece, nested switches, Max/Min of more than two
-        arguments, or breakpoints whose order cannot be decided (several symbolic gaps).
+def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[PolynomialInterval]:
+    """:func:`decompose_piecewise` for a piecewise-linear f (a piece of higher degree is refused).
 
     Examples
     --------
@@ -113,6 +115,39 @@ def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[Li
     [(0, 0), (2, -2*b)]
     >>> [(i.slope, i.intercept) for i in decompose_piecewise_linear(sympy.Heaviside(u), u)]   # a jump at 0
     [(0, 0), (0, 1)]
+    """
+    return decompose_piecewise(f, variable, max_degree=1)
+
+
+def decompose_piecewise(f: sympy.Expr, variable: sympy.Symbol, max_degree: int | None = None) -> list[PolynomialInterval]:
+    """Split a piecewise-polynomial f(u) (continuous, or jumping at its breakpoints) into polynomial intervals.
+
+    Parameters
+    ----------
+    f : sympy expression
+    variable : sympy.Symbol
+        The displacement u.
+    max_degree : int, optional
+        Refuse pieces of higher degree in u.
+
+    Returns
+    -------
+    list of PolynomialInterval
+        Ordered by u; consecutive intervals share a breakpoint.
+
+    Raises
+    ------
+    UnsupportedNonlinearityError
+        For a piece that is not a polynomial in u (or of degree above ``max_degree``),
+        nested switches, Max/Min of more than two arguments, or breakpoints whose
+        order cannot be decided (several symbolic gaps).
+
+    Examples
+    --------
+    >>> import sympy
+    >>> u = sympy.Symbol("u", real=True)
+    >>> [i.coefficients for i in decompose_piecewise(u*sympy.Abs(u), u)]
+    [(0, 0, -1), (0, 0, 1)]
     """
     atoms = _switching_atoms(f)
     switching: list[tuple[sympy.Expr, sympy.Expr]] = []  # (atom, argument whose sign decides it)
@@ -181,11 +216,13 @@ def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[Li
         for atom in piecewise:
             replacements[atom] = _piece_at(atom, variable, point, f)
         piece = sympy.expand(f.xreplace(replacements))
-        if piece.has(*_SWITCHING) or not piece.is_polynomial(variable) or sympy.degree(piece, variable) > 1:
+        if piece.has(*_SWITCHING) or not piece.is_polynomial(variable):
+            raise UnsupportedNonlinearityError(f"f = {f} is not piecewise polynomial in u (piece {piece}); {_SUPPORTED}")
+        degree = max(sympy.degree(piece, variable), 1)
+        if max_degree is not None and degree > max_degree:
             raise UnsupportedNonlinearityError(f"f = {f} is not piecewise linear in u (piece {piece}); {_SUPPORTED}")
-        slope = piece.coeff(variable, 1)
-        intercept = piece.coeff(variable, 0)
+        coefficients = tuple(sympy.simplify(piece.coeff(variable, power)) for power in range(degree + 1))
         lower = unique[index - 1] if index > 0 else None
         upper = unique[index] if index < len(unique) else None
-        intervals.append(LinearInterval(lower, upper, sympy.simplify(slope), sympy.simplify(intercept)))
+        intervals.append(PolynomialInterval(lower, upper, coefficients))
     return intervals
