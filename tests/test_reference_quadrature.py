@@ -179,3 +179,18 @@ def test_invalid_problems_raise_problem_errors():
         conservative_period("u**3", "0.1", a0=1)
     with pytest.raises(ProblemError):
         conservative_period(U**3, "0.1", a0=1, precision=2)
+
+
+def test_release_at_rest_is_bit_identical_to_the_analytic_path_before_velocity():
+    # The values below were produced by the reference before initial velocities and piecewise f existed
+    # (release at rest, periodic trapezoidal rule); velocity=0 must reproduce them bit for bit.
+    period = conservative_period(U**3, "0.5", a0="1", omega0="1", precision=30)
+    assert [value._mpf_ for value in period] == [
+        (0, 6803048952829286136773106771117, -100, 103),
+        (0, 2155972272109049503467123800543, -198, 101),
+    ]
+    frequency = conservative_frequency(U**3, "0.5", a0="1", omega0="1", precision=30, velocity=0)
+    assert [value._mpf_ for value in frequency] == [
+        (0, 2968283656120665086442050530837, -101, 102),
+        (0, 3762746558705279027369083040663, -201, 102),
+    ]

@@ -18,13 +18,19 @@ Unilateral spring ``u'' + ω0² u + ε a (u − b)_+ = 0``, ``u(0) = a0``, ``u'(
     closed form, each with an error estimate; :func:`piecewise_linear_frequency_taylor_symbolic`
     — for ``b = 0`` (``T = π/ω0 + π/Ω``) the exact Taylor polynomial in ε.
 
-Smooth conservative oscillator ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0``, ``u'(0) = 0``
+Conservative oscillator ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0``, ``u'(0) = v0`` (default 0)
     :func:`conservative_period`, :func:`conservative_frequency` — the period
-    ``T = 2 |∫_b^a0 du / √(2 (V(a0) − V(u)))|``, ``V = ω0² u²/2 + ε F(u)``, by
-    quadrature, with an error estimate; :func:`frequency_taylor_coefficients` —
-    the ``ω_k`` from a Chebyshev interpolant of ``ω(ε) = 2π/T``;
-    :func:`as_mpmath_number` — how these references read a number (exact
-    inputs rounded once, at the mpmath precision in effect).
+    ``T = 2 ∫_{b−}^{b+} du / √(2 (E − V(u)))``, ``V = ω0² u²/2 + ε F(u)``,
+    ``E = v0²/2 + V(a0)``, between the turning points ``V(b±) = E``, by
+    quadrature, with an error estimate: the periodic trapezoidal rule for an
+    analytic f, tanh-sinh piece by piece between the breakpoints of a
+    piecewise-analytic f (``Max``, ``Min``, ``Abs``, ``Heaviside``, ``sign``,
+    ``Piecewise`` with arguments linear in u and real powers of them, e.g. the
+    Hertz contact ``Max(0, u)**(3/2)``; :func:`nonlinearity_breakpoints` lists
+    them); :func:`frequency_taylor_coefficients` — the ``ω_k`` from a Chebyshev
+    interpolant of ``ω(ε) = 2π/T``; :func:`as_mpmath_number` — how these
+    references read a number (exact inputs rounded once, at the mpmath
+    precision in effect).
 
 Nonlinear normal modes of ``M X'' + K X + ε W (A X − b)_+ = 0``
     :func:`release_amplitudes_by_series` — the release amplitudes ``a_k``
@@ -56,6 +62,7 @@ from .quadrature import (
     conservative_frequency,
     conservative_period,
     frequency_taylor_coefficients,
+    nonlinearity_breakpoints,
 )
 
 __all__ = [
@@ -68,6 +75,7 @@ __all__ = [
     "conservative_period",
     "conservative_frequency",
     "frequency_taylor_coefficients",
+    "nonlinearity_breakpoints",
     "as_mpmath_number",
     "release_amplitudes_by_series",
 ]
