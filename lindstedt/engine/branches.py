@@ -35,8 +35,15 @@ first harmonic of the exact ``W_j`` including the moving-boundary terms
 ("harmonic").  ``W_j'(π) = 0`` is the secular (Fredholm) condition that fixes
 ``A_n``; for k ≠ j it fixes the periodic solution, which exists iff r_k ∉ ℤ.
 
+A fractional power law c (W − κ)^p on the first piece (Hertz contact, p = 3/2) makes
+that piece's solution non-analytic at its moving end; the piece is then a
+:class:`~lindstedt.engine.stretched.StretchedArc` (``BranchSystem.arc``): solved on the fixed
+interval τ = s/s* ∈ [0, 1], it gives μ_n = [Ω²/s*²]_n and the end slope, and the order's
+unknowns become ``A_n`` and ``σ_{1,n}``, fixed by ``A_n = [μ s*²]_n`` and ``W'(π) = 0`` after
+the next piece is matched to the arc's end (value κ, slope Y'(1)/s*).
+
 Coefficients live in any sympy field: exact (``QQ``, ``QQ(π, κ, β, …)``) or a
-``RealField`` of the working precision.
+``RealField`` of the working precision (always, with a stretched arc).
 """
 
 from __future__ import annotations
@@ -51,6 +58,7 @@ import numpy as np
 from .._errors import ResonanceError
 from ..algebra.branch import Branch, EvaluationPoint
 from .orders import LazyOrders, shift_powers
+from .stretched import FloatArc
 
 __all__ = ["BranchHierarchy", "BranchSystem", "ContactState", "FloatBranches", "MovingBoundary"]
 
@@ -112,6 +120,7 @@ class BranchSystem:
     pi_point: EvaluationPoint
     release: tuple[Any, ...]
     gauge: int = 1
+    arc: Any = None  # a StretchedArc solving the first piece (N = 1, fractional power law), or None
 
     def release_at(self, order: int) -> Any | None:
         """The prescribed W_{order,j}(0) in the gauge's powers (None: zero)."""
@@ -205,6 +214,7 @@ class FloatBranches:
 
     terms: tuple
     shifts: tuple
+    arc: FloatArc | None = None  # evaluates the first piece when it is a stretched arc
 
     @cached_property
     def _arrays(self) -> tuple[np.ndarray, list[list[list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]]]]:
@@ -247,6 +257,11 @@ class FloatBranches:
                 if not np.any(mask):
                     continue
                 points = folded[mask]
+            if piece == 0 and self.arc is not None:
+                contact_angle = weights @ shifts[:, 0]
+                values = self.arc.evaluate(points / contact_angle, weights, derivative)
+                result[mask, 0] = values * sign[mask] / contact_angle if derivative else values
+                continue
             for component, groups in enumerate(components):
                 values = sum((_evaluate_terms(*group[:3], weights @ group[3], points, derivative) for group in groups), np.zeros(points.shape))
                 result[mask, component] = values * sign[mask] if derivative else values
@@ -305,6 +320,8 @@ class BranchHierarchy(LazyOrders):
         self._lag = int(any(boundary.grazing for boundary in system.boundaries))
         self._derivatives: dict[tuple[int, int, int, int], Branch] = {}
         self._law_powers: dict[tuple[int, int, int], Branch] = {}
+        # with a stretched arc: Q_n = [Y'(1)/s*]_n, the slope it hands to the next piece
+        self._arc_quotients: list[Any] = [-system.boundaries[0].sine] if system.arc is not None else []
         self._resonant = Branch(domain, {(1, 1, 1): domain.one / domain.convert(2)})  # s sin s / 2 solves v'' + v = cos s
         self._resonant_slope = self._resonant.derivative()
         # r_k as domain elements (the mode component's frequency is 1)
@@ -343,7 +360,8 @@ class BranchHierarchy(LazyOrders):
         )
         self._ensure(highest + self._lag)
         shifts = tuple(tuple(to_float(value) for value in self.boundary_shift(n)) for n in range(highest + 1))
-        return FloatBranches(terms, shifts)
+        arc = None if self.system.arc is None else self.system.arc.float_arc(highest)
+        return FloatBranches(terms, shifts, arc)
 
     def _law_power(self, piece: int, power: int, order: int) -> Branch:
         """[W^power]_order on ``piece`` (N = 1): Σ_i [W^{power−1}]_i W_{order−i}, memoised."""
@@ -418,8 +436,12 @@ class BranchHierarchy(LazyOrders):
         def unit(index: int) -> _Affine:
             return _Affine(zero, [one if position == index else zero for position in range(unknown_count)])
 
+        arc = system.arc
         particular: list[list[Branch]] = []
         for piece, state in enumerate(system.states):
+            if piece == 0 and arc is not None:  # the stretched arc solves this piece itself
+                particular.append([Branch(domain)])
+                continue
             components = []
             for k in range(size):
                 rhs = Branch(domain)
@@ -461,6 +483,12 @@ class BranchHierarchy(LazyOrders):
             point = boundary.point
             powers = self._shift_powers(index, order)
             left, right = index, index + 1
+            if index == 0 and arc is not None:
+                c_next, d_next, quotient = self._match_arc(order, point, boundary, powers, value_of, constant, unit)
+                c_values.append(c_next)
+                d_values.append(d_next)
+                shift_values.append(unit(1))
+                continue
             # W_{n,k} on the left piece at β, and its known Taylor terms there (W_order and σ_order excluded)
             values = [value_of(left, k, c_values[left][k], d_values[left][k], point, False) for k in range(size)]
             known = [self._known(index, left, k, order, 0, powers) for k in range(size)]
@@ -494,7 +522,9 @@ class BranchHierarchy(LazyOrders):
             d_values.append(d_next)
         last = len(system.states) - 1
         equations = [value_of(last, k, c_values[last][k], d_values[last][k], system.pi_point, True) for k in range(size)]
-        if self.normalization == "initial":
+        if arc is not None:  # the release is the arc's; the unknowns are tied by A_n = [μ s*²]_n
+            equations.append(self._arc_frequency_condition(order, unit))
+        elif self.normalization == "initial":
             release = value_of(0, mode, c_values[0][mode], d_values[0][mode], system.zero_point, False)
             prescribed = system.release_at(order)
             equations.append(release if prescribed is None else release.shift(-prescribed))
@@ -503,6 +533,9 @@ class BranchHierarchy(LazyOrders):
         unknowns = solve_linear([list(e.coefficients) for e in equations], [-e.base for e in equations], domain, order)
         branches = []
         for piece in range(len(system.states)):
+            if piece == 0 and arc is not None:
+                branches.append([Branch(domain)])  # the arc's own representation (StretchedArc) stands here
+                continue
             components = []
             for k in range(size):
                 frequency = system.frequency(k)
@@ -520,7 +553,52 @@ class BranchHierarchy(LazyOrders):
         for shifts, value in zip(self._shifts, shift_values):
             if value is not None:
                 shifts.append(value.value(unknowns))
+        if arc is not None:
+            self._arc_quotients.append(quotient.value(unknowns))
         self.counters["orders"] += 1
+
+    def _arc_coefficients(self, order: int) -> tuple[Any, Any]:
+        """(μ_order, Y_order'(1)) of the stretched arc, as domain elements."""
+        mu, slope = self.system.arc.coefficients(order)
+        # RealField.dtype keeps every digit of an mpf (RealField.convert goes through a float)
+        return self._domain.dtype(mu), self._domain.dtype(slope)
+
+    def _match_arc(self, order: int, point: EvaluationPoint, boundary: MovingBoundary, powers: list, value_of: Any, constant: Any, unit: Any) -> tuple:
+        """The next piece's homogeneous parts from the arc's end: W(s*) = κ and W'(s*) = Y'(1)/s*, at order n.
+
+        Unknowns: A_n (index 0) and σ_n (index 1).  W_0 = cos s, so the σ_n terms at β are
+        W_0'(β) σ_n = −sin β σ_n (value) and W_0''(β) σ_n = −κ σ_n (slope);
+        Q = Y'(1)/s* gives Q_n = (P_n − Σ_{j=1}^{n−1} σ_j Q_{n−j} − σ_n Q_0)/β, Q_0 = −sin β.
+        """
+        domain = self._domain
+        sine, cosine, beta = boundary.sine, point.cos_multiple(1), point.value
+        _, slope = self._arc_coefficients(order)
+        shifts = self._shifts[0]
+        known_quotient = slope
+        for j in range(1, order):
+            known_quotient = known_quotient - shifts[j] * self._arc_quotients[order - j]
+        quotient = constant(known_quotient / beta) + unit(1).scale(sine / beta)
+        value = unit(1).scale(sine).shift(-self._known(0, 1, 0, order, 0, powers))
+        slope_target = (quotient + unit(1).scale(cosine)).shift(-self._known(0, 1, 0, order, 1, powers))
+        x = value - value_of(1, 0, constant(domain.zero), constant(domain.zero), point, False)
+        y = slope_target - value_of(1, 0, constant(domain.zero), constant(domain.zero), point, True)
+        return [x.scale(cosine) - y.scale(sine)], [x.scale(sine) + y.scale(cosine)], quotient
+
+    def _arc_frequency_condition(self, order: int, unit: Any) -> _Affine:
+        """A_n − [μ s*²]_n = 0 (μ = Ω²/s*², s* = β + Σ σ_j ε̂^j), affine in (A_n, σ_n)."""
+        domain = self._domain
+        shifts = self._shifts[0]
+        beta = shifts[0]
+
+        def squared(j: int) -> Any:  # [s*²]_j for j < order
+            return sum((shifts[i] * shifts[j - i] for i in range(j + 1)), domain.zero)
+
+        known = sum((shifts[i] * shifts[order - i] for i in range(1, order)), domain.zero)
+        mu_zero = domain.one / (beta * beta)
+        total = unit(1).scale(2 * beta * mu_zero).shift(known * mu_zero)
+        for i in range(1, order + 1):
+            total = total.shift(self._arc_coefficients(i)[0] * squared(order - i))
+        return unit(0) - total
 
     def _first_harmonic_condition(self, order: int, particular: list, c_values: list, d_values: list, resonant_unit: _Affine) -> _Affine:
         """ε̂^order coefficient of ∫_0^π W_j cos s ds (must vanish), affine in the unknowns."""

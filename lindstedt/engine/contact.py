@@ -25,17 +25,19 @@ w_0 − κ_i) carries no contact at order zero; it is reported with validity
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 from typing import Any
 
 import mpmath
 import sympy
 from sympy import QQ, RealField
 
-from .._errors import ProblemError
+from .._errors import ProblemError, UnsupportedNonlinearityError
 from ..problems.piecewise_linear import decompose_piecewise
 from ..problems.oscillator import DISPLACEMENT, Oscillator
 from ..algebra.branch import EvaluationPoint
 from .branches import BranchHierarchy, BranchSystem, ContactState, MovingBoundary
+from .stretched import StretchedArc
 
 __all__ = ["ContactBoundary", "PiecewiseNormalForm", "contact_normal_form"]
 
@@ -193,18 +195,23 @@ def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hi
     amplitude = problem.a0
     sign = _sign_of_amplitude(amplitude)
     # w-breakpoints κ_i = u_i / a0, and the law f̂(w) = f(a0 w)/a0 = Σ_m c_m a0^{m−1} w^m on each interval.
-    w_intervals: list[tuple[sympy.Expr | None, sympy.Expr | None, tuple[sympy.Expr, ...]]] = []
+    # A fractional term c |u − b|^p becomes c |a0|^p |w − κ|^p / a0, κ = b/a0.
+    w_intervals: list[tuple[sympy.Expr | None, sympy.Expr | None, tuple[sympy.Expr, ...], tuple]] = []
     for interval in intervals:
         lower = None if interval.lower is None else interval.lower / amplitude
         upper = None if interval.upper is None else interval.upper / amplitude
         if sign < 0:
             lower, upper = upper, lower
         law = tuple(coefficient * amplitude ** (power - 1) for power, coefficient in enumerate(interval.coefficients))
-        w_intervals.append((lower, upper, law))
+        fractional = tuple(
+            (coefficient * abs(amplitude) ** exponent / amplitude, point / amplitude, exponent)
+            for coefficient, point, exponent in interval.fractional
+        )
+        w_intervals.append((lower, upper, law, fractional))
     if sign < 0:
         w_intervals.reverse()
     # Breakpoints in w, increasing; classify each against the orbit [-1, 1].
-    kappas = [upper for (_, upper, _) in w_intervals[:-1]]
+    kappas = [upper for (_, upper, _, _) in w_intervals[:-1]]
     crossing: list[int] = []
     grazing: list[sympy.Expr] = []
     classes: list[tuple[sympy.Expr, str]] = []
@@ -264,6 +271,42 @@ def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hi
     return form
 
 
+def _stretched_arc(problem: Oscillator, w_intervals: list, interval_of: list[int], fractional_pieces: list[int],
+                   crossing_kappas: list[sympy.Expr], grazing: list, field: "_ConstantField", releases: list) -> StretchedArc:
+    """The first piece as a stretched arc (a fractional power law c (w − κ)^p about the release point)."""
+    supported = (
+        "a fractional power law (Hertz c*Max(0, u - b)**(3/2)) is supported on the contact arc that contains "
+        "the release point, with the other pieces polynomial: release the oscillator on the contact side "
+        "(a0 inside the contact) and give numeric values"
+    )
+    fractional = w_intervals[interval_of[0]][3]
+    if fractional_pieces != [0] or len(fractional) != 1 or grazing or not crossing_kappas:
+        raise UnsupportedNonlinearityError(f"f = {problem.f}: {supported}")
+    coefficient, kappa, exponent = fractional[0]
+    top_kappa = max(crossing_kappas, key=lambda k: k if k.is_number else 0)
+    if sympy.simplify(kappa - top_kappa) != 0 or not kappa.is_number or not coefficient.is_number:
+        raise UnsupportedNonlinearityError(f"f = {problem.f}: {supported}")
+    if problem.normalization != "initial":
+        raise UnsupportedNonlinearityError(f"f = {problem.f}: a fractional power law needs normalization='initial' (a0 is the release point)")
+    if not field.numeric:
+        raise ProblemError(f"f = {problem.f}: a fractional power law is expanded numerically; pass numeric=True (and precision=...)")
+    digits = field.digits + 10
+
+    def number(value: sympy.Expr) -> mpmath.mpf:
+        with mpmath.workdps(digits):
+            return mpmath.mpf(sympy.N(value, digits))
+
+    releases_mp = [number(value) for value in releases]
+    return StretchedArc(
+        number(kappa),
+        Fraction(int(exponent.p), int(exponent.q)),
+        number(coefficient),
+        [number(value) for value in w_intervals[interval_of[0]][2]],
+        lambda order: releases_mp[order - 1] if 1 <= order <= len(releases_mp) else None,
+        field.digits,
+    )
+
+
 def _assemble(
     problem: Oscillator,
     w_intervals: list,
@@ -278,6 +321,9 @@ def _assemble(
 ) -> PiecewiseNormalForm:
     """The normal form with its coefficient field; ``crossed`` lists the grazing breakpoints
     (κ, interval beyond, σ_1) that the perturbed orbit passes (gauge η = ε̂^{1/2})."""
+    fractional_pieces = [piece for piece, interval_index in enumerate(interval_of) if w_intervals[interval_index][3]]
+    if fractional_pieces and crossed:
+        raise UnsupportedNonlinearityError(f"f = {problem.f}: a fractional power law at a grazing breakpoint is not supported")
     top = [item for item in crossed if item[0] > 0]
     bottom = [item for item in crossed if item[0] < 0]
     interval_of = [item[1] for item in top] + list(interval_of) + [item[1] for item in bottom]
@@ -296,6 +342,7 @@ def _assemble(
     field = _ConstantField(values, digits)
     domain = field.domain
     piece_laws = [tuple(field.convert(value) for value in w_intervals[interval_index][2]) for interval_index in interval_of]
+    arc = _stretched_arc(problem, w_intervals, interval_of, fractional_pieces, crossing_kappas, grazing, field, releases) if fractional_pieces else None
     zero = EvaluationPoint(domain, domain.zero, domain.one, domain.zero)
     pi_point = EvaluationPoint(domain, field.convert(sympy.pi), -domain.one, domain.zero)
     boundaries, moving = [], []
@@ -326,6 +373,7 @@ def _assemble(
         pi_point=pi_point,
         release=tuple(field.convert(release) for release in releases),
         gauge=gauge,
+        arc=arc,
     )
     if grazing:
         regime = "grazing"

@@ -22,15 +22,16 @@ import sympy
 
 from .._errors import UnsupportedNonlinearityError
 
-__all__ = ["PolynomialInterval", "decompose_piecewise", "decompose_piecewise_linear"]
+__all__ = ["PolynomialInterval", "decompose_piecewise", "decompose_piecewise_linear", "has_fractional_power"]
 
 _SWITCHING = (sympy.Max, sympy.Min, sympy.Abs, sympy.Heaviside, sympy.sign, sympy.Piecewise)
 _SUPPORTED = (
     "supported non-smooth f: piecewise-polynomial laws such as a*Max(0, u - b), "
     "a*(u - b)*Heaviside(u - b), Max(0, -u - b), Abs(u - b), Max(0, u - b)**2, u*Abs(u), "
     "Heaviside(u)*u**2, c*Heaviside(u - b), sign(u), "
-    "Piecewise((polynomial, u < b), ..., (polynomial, True)), plus polynomial terms "
-    "(fractional powers such as the Hertz law Max(0, u)**(3/2) and non-polynomial pieces are not supported yet)"
+    "Piecewise((polynomial, u < b), ..., (polynomial, True)), plus polynomial terms, "
+    "and fractional powers of the distance to a breakpoint such as the Hertz law c*Max(0, u - b)**(3/2) "
+    "(rational exponent p > 0; non-polynomial analytic pieces are not supported)"
 )
 
 
@@ -41,6 +42,8 @@ class PolynomialInterval:
     lower: sympy.Expr | None
     upper: sympy.Expr | None
     coefficients: tuple[sympy.Expr, ...]  # increasing degree, at least (c_0, c_1)
+    # terms c·|u − b|^p with b = lower or upper, p a positive non-integer rational: (c, b, p)
+    fractional: tuple[tuple[sympy.Expr, sympy.Expr, sympy.Rational], ...] = ()
 
     @property
     def slope(self) -> sympy.Expr:
@@ -102,6 +105,19 @@ def _piece_at(atom: sympy.Piecewise, variable: sympy.Symbol, point: sympy.Expr, 
         if holds is not sympy.false:
             raise UnsupportedNonlinearityError(f"f = {f}: cannot decide the Piecewise condition {condition} between breakpoints")
     raise UnsupportedNonlinearityError(f"f = {f}: the Piecewise {atom} is undefined between breakpoints (add a last piece (…, True))")
+
+
+def has_fractional_power(f: sympy.Expr, variable: sympy.Symbol) -> bool:
+    """True when f has a non-integer power of an expression in u (then it is expanded numerically).
+
+    Examples
+    --------
+    >>> import sympy
+    >>> u = sympy.Symbol("u", real=True)
+    >>> has_fractional_power(sympy.Max(0, u)**sympy.Rational(3, 2), u), has_fractional_power(sympy.Max(0, u)**2, u)
+    (True, False)
+    """
+    return any(atom.base.has(variable) and not atom.exp.is_Integer for atom in f.atoms(sympy.Pow))
 
 
 def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[PolynomialInterval]:
@@ -204,7 +220,7 @@ def decompose_piecewise(f: sympy.Expr, variable: sympy.Symbol, max_degree: int |
             return unique[-1] + 1
         return (unique[index - 1] + unique[index]) / 2
 
-    intervals: list[LinearInterval] = []
+    intervals: list[PolynomialInterval] = []
     for index in range(len(unique) + 1):
         point = test_point(index)
         replacements = {}
@@ -215,14 +231,54 @@ def decompose_piecewise(f: sympy.Expr, variable: sympy.Symbol, max_degree: int |
             replacements[atom] = _branch_value(atom, int(sign_value))
         for atom in piecewise:
             replacements[atom] = _piece_at(atom, variable, point, f)
-        piece = sympy.expand(f.xreplace(replacements))
+        piece = f.xreplace(replacements)
+        lower = unique[index - 1] if index > 0 else None
+        upper = unique[index] if index < len(unique) else None
+        fractional: list[tuple[sympy.Expr, sympy.Expr, sympy.Rational]] = []
+        if max_degree is None and not piece.has(*_SWITCHING):
+            # non-integer powers of u stand as placeholders while the rest is expanded
+            placeholders = {
+                atom: sympy.Dummy("power")
+                for atom in piece.atoms(sympy.Pow)
+                if atom.base.has(variable) and not (atom.exp.is_Integer and atom.exp >= 0)
+            }
+            piece = sympy.expand(piece.xreplace(placeholders))
+            for atom, placeholder in placeholders.items():
+                coefficient = piece.coeff(placeholder)
+                piece = sympy.expand(piece - coefficient * placeholder)
+                if coefficient.has(variable) or coefficient.has(*placeholders.values()):
+                    raise UnsupportedNonlinearityError(f"f = {f}: the term {coefficient * atom} is not c*Max(0, u - b)**p; {_SUPPORTED}")
+                fractional.append(_fractional_term(coefficient, atom, variable, (lower, upper), point, f))
+        piece = sympy.expand(piece)
         if piece.has(*_SWITCHING) or not piece.is_polynomial(variable):
             raise UnsupportedNonlinearityError(f"f = {f} is not piecewise polynomial in u (piece {piece}); {_SUPPORTED}")
         degree = max(sympy.degree(piece, variable), 1)
         if max_degree is not None and degree > max_degree:
             raise UnsupportedNonlinearityError(f"f = {f} is not piecewise linear in u (piece {piece}); {_SUPPORTED}")
         coefficients = tuple(sympy.simplify(piece.coeff(variable, power)) for power in range(degree + 1))
-        lower = unique[index - 1] if index > 0 else None
-        upper = unique[index] if index < len(unique) else None
-        intervals.append(PolynomialInterval(lower, upper, coefficients))
+        intervals.append(PolynomialInterval(lower, upper, coefficients, tuple(fractional)))
     return intervals
+
+
+def _fractional_term(coefficient: sympy.Expr, power: sympy.Pow, variable: sympy.Symbol, ends: tuple, inside: sympy.Expr, f: sympy.Expr):
+    """``(c', b, p)`` for ``coefficient·(±(u − b))^p = c'·|u − b|^p``: p a positive non-integer rational, b an
+    end of the interval and the base positive inside it (anything else is refused)."""
+    term = coefficient * power
+    base, exponent = power.base, power.exp
+    if not exponent.is_Rational:
+        raise UnsupportedNonlinearityError(f"f = {f}: the exponent {exponent} of {term} must be a rational number; {_SUPPORTED}")
+    if exponent <= 0:
+        raise UnsupportedNonlinearityError(
+            f"f = {f}: the force {term} is unbounded where {base} vanishes (exponent {exponent} <= 0); {_SUPPORTED}"
+        )
+    slope, offset = _linear_argument(base, variable, f)
+    root = -offset / slope
+    if not any(end is not None and sympy.simplify(root - end) == 0 for end in ends):
+        raise UnsupportedNonlinearityError(
+            f"f = {f}: the power {term} must vanish at a breakpoint of its piece (write it as Max(0, u - b)**p); {_SUPPORTED}"
+        )
+    sign = sympy.sign(sympy.simplify(base.subs(variable, inside)))
+    if sign != 1:
+        raise UnsupportedNonlinearityError(f"f = {f}: the base of {term} must be positive on its piece; {_SUPPORTED}")
+    # c·(slope (u − root))^p = c·|slope|^p |u − root|^p (slope·(u − root) > 0 inside)
+    return sympy.simplify(coefficient * abs(slope) ** exponent), root, exponent

@@ -1,0 +1,280 @@
+"""A contact arc under a fractional power law, on a fixed interval (Hertz contact and its kin).
+
+Problem: the first piece ``s ∈ [0, s*(ε̂))`` of the branch hierarchy (N = 1, see
+:mod:`lindstedt.engine.branches`), on which the normalised law is
+
+    Ω² W'' + W + ε̂ f̂(W) = 0,   f̂(W) = Σ_m c_m W^m + c (W − κ)^p,   W > κ,
+
+with a rational exponent ``p = q/d > 0`` that is not an integer (Hertz: p = 3/2).
+The solution is not analytic at the contact point W = κ (W − κ ~ s* − s, so
+W'' ~ (s* − s)^p), and that point moves with ε̂: Lindstedt coefficients W_n(s) at a
+fixed s would diverge there from the order where p − n < −1.  So the arc is mapped
+to a fixed interval: ``τ = s/s*(ε̂) ∈ [0, 1]``, ``Y(τ) = W(s* τ)``, ``μ = Ω²/s*²``:
+
+    μ Y'' + Y + ε̂ f̂(Y) = 0,   Y'(0) = 0,   Y(0) = 1 + Σ w_n ε̂^n (the release),   Y(1) = κ,
+
+and the contact point stays at τ = 1 for every ε̂.  With ``Y = Σ ε̂^n Y_n``,
+``Y_0 = cos βτ``, ``β = arccos κ``, ``μ = Σ μ_n ε̂^n``, ``μ_0 = 1/β²``, the vanishing
+factor stays a fixed weight,
+
+    (Y − κ)^p = (Y_0 − κ)^p (1 + Σ_{j≥1} R_j ε̂^j)^p,   R_j = Y_j/(Y_0 − κ)   (bounded: Y_j(1) = 0),
+
+expanded by the recurrence for powers of a power series.  Order n ≥ 1 reads
+
+    Y_n'' + β² Y_n = g_n = −β² (μ_n Y_0'' + Σ_{i=1}^{n−1} μ_i Y_{n−i}'' + [f̂(Y)]_{n−1}),
+
+solved by variation of parameters from τ = 0 (ĝ_n is g_n without its μ_n term),
+
+    Y_n = w_n cos βτ + (β³ μ_n/2) τ sin βτ + (1/β)[sin βτ ∫_0^τ cos βt ĝ_n dt − cos βτ ∫_0^τ sin βt ĝ_n dt],
+
+with μ_n from the contact condition Y_n(1) = 0.  The branch hierarchy takes μ_n and the
+slope Y_n'(1) to match the next piece (``s*² = Ω²/μ``).
+
+**Representation.**  Every Y_n is analytic in ``v = (1 − τ)^{1/d}`` on [0, 1] (the
+powers (1 − τ)^{k/d} that the contact point brings are powers of v, and τ = 1 − v^d),
+so it is kept by its values at M Chebyshev points of the first kind in v (interior
+points: R_j is 0/0 at v = 0) and the integrals are cumulative Chebyshev integrals in v
+(t = 1 − ν^d, dt = −d ν^{d−1} dν), which converge geometrically.  M doubles until
+the Chebyshev tail of every Y_n is below the working precision.  Arithmetic is mpmath
+at the requested digits plus guard digits (the quotient R_j near v = 0 loses up to
+log10(1/v_min^d) of them).
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from typing import Any, Sequence
+
+import mpmath
+import numpy as np
+
+from .._errors import ConvergenceError
+
+__all__ = ["StretchedArc", "FloatArc"]
+
+_INITIAL_NODES = 32
+_MAXIMUM_NODES = 1024
+_GUARD_DIGITS = 20
+
+
+class FloatArc:
+    """Float image of Y_0 … Y_N for fast evaluation: Chebyshev coefficients in x = 2v − 1 of Y_n and dY_n/dτ."""
+
+    def __init__(self, denominator: int, values: Sequence[np.ndarray], slopes: Sequence[np.ndarray]):
+        self.denominator = denominator
+        self.values = np.array(values)
+        self.slopes = np.array(slopes)
+
+    def evaluate(self, stretched_time: np.ndarray, weights: np.ndarray, derivative: bool) -> np.ndarray:
+        """Σ_n weights[n] Y_n(τ) (or dY_n/dτ) at τ ∈ [0, 1]."""
+        position = np.clip(1.0 - stretched_time, 0.0, 1.0) ** (1.0 / self.denominator)
+        coefficients = weights @ (self.slopes if derivative else self.values)
+        return np.polynomial.chebyshev.chebval(2.0 * position - 1.0, coefficients)
+
+
+class StretchedArc:
+    """Order-by-order solution on the stretched contact arc (module docstring), lazy and memoised.
+
+    Parameters
+    ----------
+    kappa : number
+        The contact point κ (|κ| < 1) of the normalised displacement.
+    exponent : Fraction
+        p = q/d > 0, not an integer.
+    coefficient : number
+        c of the fractional term c (W − κ)^p.
+    polynomial : sequence of numbers
+        c_0, c_1, … of the polynomial part of the law on the arc.
+    release : callable order -> number or None
+        w_n = Y_n(0) (None: 0).
+    digits : int
+        Decimal digits wanted.
+
+    Examples
+    --------
+    >>> from fractions import Fraction
+    >>> arc = StretchedArc(0, Fraction(3, 2), 1, (), lambda n: None, 20)
+    >>> mu, slope = arc.coefficients(1)
+    >>> abs(mu) > 0
+    True
+    """
+
+    def __init__(self, kappa: Any, exponent: Fraction, coefficient: Any, polynomial: Sequence[Any], release: Any, digits: int):
+        if exponent <= 0 or exponent.denominator == 1:
+            raise ValueError("the stretched arc is for non-integer exponents p > 0")
+        self.exponent = exponent
+        self.denominator = exponent.denominator
+        self.digits = digits
+        self._working = digits + _GUARD_DIGITS
+        self._release = release
+        with mpmath.workdps(self._working):
+            self.kappa = mpmath.mpf(kappa)
+            self.coefficient = mpmath.mpf(coefficient)
+            self.polynomial = [mpmath.mpf(value) for value in polynomial]
+            self.beta = mpmath.acos(self.kappa)
+        self.nodes = _INITIAL_NODES
+        self._reset()
+        self.counters = {"orders": 0, "restarts": 0}
+
+    # -- grid -------------------------------------------------------------------------------------------
+    def _reset(self) -> None:
+        M, d = self.nodes, self.denominator
+        with mpmath.workdps(self._working):
+            angles = [mpmath.pi * (i + mpmath.mpf(1) / 2) / M for i in range(M)]
+            x = [mpmath.cos(angle) for angle in angles]
+            self._x = x
+            self._v = [(xi + 1) / 2 for xi in x]
+            self._tau = [1 - vi**d for vi in self._v]
+            beta = self.beta
+            self._cos = [mpmath.cos(beta * t) for t in self._tau]
+            self._sin = [mpmath.sin(beta * t) for t in self._tau]
+            # Y_0 − κ = cos βτ − cos β = 2 sin(β(1 + τ)/2) sin(β v^d/2), without cancellation near τ = 1
+            self._gap = [2 * mpmath.sin(beta * (1 + t) / 2) * mpmath.sin(beta * vi**d / 2) for t, vi in zip(self._tau, self._v)]
+            self._weight = [self.coefficient * g**self.exponent for g in self._gap]
+            self._jacobian = [d * vi ** (d - 1) for vi in self._v]  # −dt/dν
+            self._transform = [[mpmath.cos(k * angle) for angle in angles] for k in range(M)]
+        self._values: list[list[Any]] = [list(self._cos)]  # Y_n at the nodes
+        self._second: list[list[Any]] = [[-beta * beta * c for c in self._cos]]  # Y_n''
+        self._ratios: list[list[Any]] = [[]]  # R_n (n ≥ 1)
+        self._binomial: list[list[Any]] = [[mpmath.mpf(1)] * M]  # B_n of (1 + Σ R ε̂)^p
+        self._powers: dict[tuple[int, int], list[Any]] = {}
+        self._mu: list[Any] = [1 / (beta * beta)]
+        self._slope: list[Any] = [-beta * mpmath.sin(beta)]
+        self._series: list[tuple[list[Any], list[Any]]] = []  # Chebyshev coefficients of Y_n and Y_n' (n ≥ 1)
+        self.tail = mpmath.mpf(0)
+
+    def _coefficients(self, values: list[Any]) -> list[Any]:
+        """Chebyshev coefficients a_k (a_0 halved) of the interpolant through the node values."""
+        M = self.nodes
+        scale = mpmath.mpf(2) / M
+        coefficients = [scale * mpmath.fsum(row[i] * values[i] for i in range(M)) for row in self._transform]
+        coefficients[0] /= 2
+        return coefficients
+
+    def _integral_to_end(self, integrand: list[Any]) -> tuple[list[Any], Any]:
+        """∫_v^1 h(ν) dν at every node and ∫_0^1 h: cumulative Chebyshev integration in x = 2ν − 1."""
+        M = self.nodes
+        a = self._coefficients(integrand) + [mpmath.mpf(0), mpmath.mpf(0)]
+        b = [mpmath.mpf(0)] * (M + 1)
+        b[1] = a[0] - a[2] / 2
+        for k in range(2, M + 1):
+            b[k] = (a[k - 1] - a[k + 1]) / (2 * k)
+        top = mpmath.fsum(b)
+        bottom = mpmath.fsum(value if k % 2 == 0 else -value for k, value in enumerate(b))
+        at_nodes = []
+        for i in range(M):
+            angle_values = [self._transform[k][i] for k in range(M)]
+            # T_M(x_i) = cos(M θ_i) = 0 at first-kind nodes
+            at_nodes.append((top - mpmath.fsum(b[k] * angle_values[k] for k in range(M))) / 2)
+        return at_nodes, (top - bottom) / 2
+
+    # -- the hierarchy ----------------------------------------------------------------------------------
+    def _law_power(self, power: int, order: int) -> list[Any]:
+        """[Y^power]_order at the nodes."""
+        key = (power, order)
+        if key not in self._powers:
+            if power == 1:
+                result = self._values[order]
+            else:
+                result = [mpmath.mpf(0)] * self.nodes
+                for i in range(order + 1):
+                    left, right = self._law_power(power - 1, i), self._values[order - i]
+                    result = [r + x * y for r, x, y in zip(result, left, right)]
+            self._powers[key] = result
+        return self._powers[key]
+
+    def _law(self, order: int) -> list[Any]:
+        """[f̂(Y)]_order at the nodes."""
+        M = self.nodes
+        total = [self._weight[i] * self._binomial[order][i] for i in range(M)]
+        for power, value in enumerate(self.polynomial):
+            if not value:
+                continue
+            if power == 0:
+                if order == 0:
+                    total = [t + value for t in total]
+                continue
+            term = self._law_power(power, order)
+            total = [t + value * x for t, x in zip(total, term)]
+        return total
+
+    def _solve(self, order: int) -> None:
+        M, beta = self.nodes, self.beta
+        p = mpmath.mpf(self.exponent.numerator) / self.exponent.denominator
+        law = self._law(order - 1)
+        forcing = [-beta * beta * value for value in law]
+        for i in range(1, order):
+            mu = self._mu[i]
+            forcing = [g - beta * beta * mu * y for g, y in zip(forcing, self._second[order - i])]
+        integrand_cos = [j * c * g for j, c, g in zip(self._jacobian, self._cos, forcing)]
+        integrand_sin = [j * s * g for j, s, g in zip(self._jacobian, self._sin, forcing)]
+        cos_integral, cos_total = self._integral_to_end(integrand_cos)
+        sin_integral, sin_total = self._integral_to_end(integrand_sin)
+        release = self._release(order)
+        release = mpmath.mpf(0) if release is None else mpmath.mpf(release)
+        sin_b, cos_b = mpmath.sin(beta), mpmath.cos(beta)
+        particular_end = (sin_b * cos_total - cos_b * sin_total) / beta
+        resonant = beta**3 / 2
+        mu = -(release * cos_b + particular_end) / (resonant * sin_b)
+        values, slopes, second = [], [], []
+        for i in range(M):
+            t, c, s = self._tau[i], self._cos[i], self._sin[i]
+            particular = (s * cos_integral[i] - c * sin_integral[i]) / beta
+            particular_slope = c * cos_integral[i] + s * sin_integral[i]
+            value = release * c + resonant * mu * t * s + particular
+            values.append(value)
+            slopes.append(-release * beta * s + resonant * mu * (s + beta * t * c) + particular_slope)
+            second.append(forcing[i] + beta**4 * mu * c - beta * beta * value)
+        end_slope = -release * beta * sin_b + resonant * mu * (sin_b + beta * cos_b) + cos_b * cos_total + sin_b * sin_total
+        self._values.append(values)
+        self._second.append(second)
+        self._ratios.append([y / g for y, g in zip(values, self._gap)])
+        # B_n = (1/n) Σ_{k=1}^{n} ((p + 1) k − n) R_k B_{n−k}   (powers of 1 + Σ R_k ε̂^k)
+        self._binomial.append(
+            [mpmath.fsum(((p + 1) * k - order) * self._ratios[k][i] * self._binomial[order - k][i] for k in range(1, order + 1)) / order for i in range(M)]
+        )
+        self._mu.append(mu)
+        self._slope.append(end_slope)
+        value_series, slope_series = self._coefficients(values), self._coefficients(slopes)
+        self._series.append((value_series, slope_series))
+        scale = max(abs(a) for a in value_series) or mpmath.mpf(1)
+        self.tail = max(self.tail, max(abs(a) for a in value_series[-4:]) / scale)
+
+    def _ensure(self, order: int) -> None:
+        tolerance = mpmath.mpf(10) ** (-(self.digits + 2))
+        while len(self._mu) <= order:
+            with mpmath.workdps(self._working):
+                self._solve(len(self._mu))
+            self.counters["orders"] += 1
+            if self.tail > tolerance:
+                if 2 * self.nodes > _MAXIMUM_NODES:
+                    raise ConvergenceError(
+                        f"the stretched contact arc needs more than {_MAXIMUM_NODES} Chebyshev points "
+                        f"for {self.digits} digits at order {len(self._mu) - 1} (tail {mpmath.nstr(self.tail, 3)}); "
+                        "ask for fewer digits or a lower order"
+                    )
+                reached = len(self._mu) - 1
+                self.nodes *= 2
+                self.counters["restarts"] += 1
+                self._reset()
+                self._ensure(reached)
+
+    def coefficients(self, order: int) -> tuple[Any, Any]:
+        """(μ_order, Y_order'(1)) as mpf numbers."""
+        self._ensure(order)
+        return self._mu[order], self._slope[order]
+
+    def float_arc(self, highest: int) -> FloatArc:
+        """The float evaluator of Y_0 … Y_highest."""
+        self._ensure(highest)
+        size = self.nodes
+        zeroth_values = np.zeros(size)
+        zeroth_slopes = np.zeros(size)
+        with mpmath.workdps(self._working):
+            # Y_0 = cos βτ and its τ-slope −β sin βτ, interpolated on the same grid
+            zeroth = self._coefficients(self._cos), self._coefficients([-self.beta * s for s in self._sin])
+        zeroth_values[:] = [float(a) for a in zeroth[0]]
+        zeroth_slopes[:] = [float(a) for a in zeroth[1]]
+        values = [zeroth_values] + [np.array([float(a) for a in series[0]]) for series in self._series[:highest]]
+        slopes = [zeroth_slopes] + [np.array([float(a) for a in series[1]]) for series in self._series[:highest]]
+        return FloatArc(self.denominator, values, slopes)
