@@ -29,6 +29,7 @@ BUDGETS = {
     "validity_time.ipynb": 60,
     "backbone.ipynb": 60,
     "runtime_vs_error.ipynb": 60,
+    "hertz_backbone.ipynb": 90,
 }
 #: nbclient's limit for one cell
 CELL_TIMEOUT = 120
