@@ -35,12 +35,16 @@ first harmonic of the exact ``W_j`` including the moving-boundary terms
 ("harmonic").  ``W_j'(π) = 0`` is the secular (Fredholm) condition that fixes
 ``A_n``; for k ≠ j it fixes the periodic solution, which exists iff r_k ∉ ℤ.
 
-A fractional power law c (W − κ)^p on the first piece (Hertz contact, p = 3/2) makes
-that piece's solution non-analytic at its moving end; the piece is then a
-:class:`~lindstedt.engine.stretched.StretchedArc` (``BranchSystem.arc``): solved on the fixed
-interval τ = s/s* ∈ [0, 1], it gives μ_n = [Ω²/s*²]_n and the end slope, and the order's
-unknowns become ``A_n`` and ``σ_{1,n}``, fixed by ``A_n = [μ s*²]_n`` and ``W'(π) = 0`` after
-the next piece is matched to the arc's end (value κ, slope Y'(1)/s*).
+A fractional power law c |W − κ|^p (Hertz contact, p = 3/2) on a piece that holds a
+turning point makes that piece's solution non-analytic at its moving end; the piece is
+then a :class:`~lindstedt.engine.stretched.StretchedArc`, solved on a fixed interval
+(``BranchSystem.arcs``).  The first piece [0, s_1*): τ = s/s_1*, released at W_n(0) = w_n;
+its μ_n = [Ω²/s_1*²]_n and end slope are known, the order's unknowns become ``A_n`` and
+``σ_{1,n}`` (instead of the first piece's c), fixed with ``A_n = [μ s_1*²]_n`` after the next
+piece is matched to the arc's end (value κ, slope Y'(1)/s_1*).  The last piece (s_L*, π]:
+τ = (π − s)/(π − s_L*), W = −Y; the turning value h_n = Y_n(0) at π is one more unknown, and
+the conditions are the slope match at s_L* and ``A_n = [μ (π − s_L*)²]_n`` (instead of
+``W'(π) = 0``).
 
 Coefficients live in any sympy field: exact (``QQ``, ``QQ(π, κ, β, …)``) or a
 ``RealField`` of the working precision (always, with a stretched arc).
@@ -120,7 +124,7 @@ class BranchSystem:
     pi_point: EvaluationPoint
     release: tuple[Any, ...]
     gauge: int = 1
-    arc: Any = None  # a StretchedArc solving the first piece (N = 1, fractional power law), or None
+    arcs: tuple[Any, Any] = (None, None)  # StretchedArcs solving the first / last piece (N = 1), or None
 
     def release_at(self, order: int) -> Any | None:
         """The prescribed W_{order,j}(0) in the gauge's powers (None: zero)."""
@@ -214,7 +218,7 @@ class FloatBranches:
 
     terms: tuple
     shifts: tuple
-    arc: FloatArc | None = None  # evaluates the first piece when it is a stretched arc
+    arcs: tuple[FloatArc | None, FloatArc | None] = (None, None)  # evaluate the first / last piece when stretched
 
     @cached_property
     def _arrays(self) -> tuple[np.ndarray, list[list[list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]]]]:
@@ -257,10 +261,15 @@ class FloatBranches:
                 if not np.any(mask):
                     continue
                 points = folded[mask]
-            if piece == 0 and self.arc is not None:
-                contact_angle = weights @ shifts[:, 0]
-                values = self.arc.evaluate(points / contact_angle, weights, derivative)
-                result[mask, 0] = values * sign[mask] / contact_angle if derivative else values
+            if piece == 0 and self.arcs[0] is not None:  # Y(s/s_1*)
+                length = weights @ shifts[:, 0]
+                values = self.arcs[0].evaluate(points / length, weights, derivative)
+                result[mask, 0] = values * sign[mask] / length if derivative else values
+                continue
+            if piece == len(pieces) - 1 and self.arcs[1] is not None:  # −Y((π − s)/(π − s_L*))
+                length = np.pi - weights @ shifts[:, -1]
+                values = self.arcs[1].evaluate((np.pi - points) / length, weights, derivative)
+                result[mask, 0] = values * sign[mask] / length if derivative else -values
                 continue
             for component, groups in enumerate(components):
                 values = sum((_evaluate_terms(*group[:3], weights @ group[3], points, derivative) for group in groups), np.zeros(points.shape))
@@ -320,8 +329,16 @@ class BranchHierarchy(LazyOrders):
         self._lag = int(any(boundary.grazing for boundary in system.boundaries))
         self._derivatives: dict[tuple[int, int, int, int], Branch] = {}
         self._law_powers: dict[tuple[int, int, int], Branch] = {}
-        # with a stretched arc: Q_n = [Y'(1)/s*]_n, the slope it hands to the next piece
-        self._arc_quotients: list[Any] = [-system.boundaries[0].sine] if system.arc is not None else []
+        # per stretched arc (first, last piece): its length ℓ_n (ℓ = s_1* or π − s_L*), μ_n = [Ω²/ℓ²]_n and
+        # Q_n = [Y'(1)/ℓ]_n, the slope it hands to its neighbour (Q_0 = −sin β)
+        self._arc_data: list[dict[str, list[Any]] | None] = []
+        for which, arc in enumerate(system.arcs):
+            if arc is None:
+                self._arc_data.append(None)
+                continue
+            boundary = system.boundaries[-which]  # the first boundary for the first piece, the last for the last
+            length = boundary.point.value if which == 0 else system.pi_point.value - boundary.point.value
+            self._arc_data.append({"mu": [domain.one / (length * length)], "quotient": [-boundary.sine], "length": [length]})
         self._resonant = Branch(domain, {(1, 1, 1): domain.one / domain.convert(2)})  # s sin s / 2 solves v'' + v = cos s
         self._resonant_slope = self._resonant.derivative()
         # r_k as domain elements (the mode component's frequency is 1)
@@ -360,8 +377,8 @@ class BranchHierarchy(LazyOrders):
         )
         self._ensure(highest + self._lag)
         shifts = tuple(tuple(to_float(value) for value in self.boundary_shift(n)) for n in range(highest + 1))
-        arc = None if self.system.arc is None else self.system.arc.float_arc(highest)
-        return FloatBranches(terms, shifts, arc)
+        arcs = tuple(None if arc is None else arc.float_arc(highest) for arc in self.system.arcs)
+        return FloatBranches(terms, shifts, arcs)
 
     def _law_power(self, piece: int, power: int, order: int) -> Branch:
         """[W^power]_order on ``piece`` (N = 1): Σ_i [W^{power−1}]_i W_{order−i}, memoised."""
@@ -428,7 +445,11 @@ class BranchHierarchy(LazyOrders):
         zero, one = domain.zero, domain.one
         size, mode = system.size, system.mode
         resonant = self._resonant
-        unknown_count = size + 1  # A_n, then c_k on the first piece for every component k
+        top, bottom = system.arcs
+        # A_n, then c_k on the first piece for every component k (σ_{1,n} with a first-piece arc),
+        # then h_n with a last-piece arc
+        unknown_count = size + 1 + (bottom is not None)
+        turning = size + 1
 
         def constant(value: Any) -> _Affine:
             return _Affine(value, [zero] * unknown_count)
@@ -436,11 +457,11 @@ class BranchHierarchy(LazyOrders):
         def unit(index: int) -> _Affine:
             return _Affine(zero, [one if position == index else zero for position in range(unknown_count)])
 
-        arc = system.arc
+        last_piece = len(system.states) - 1
         particular: list[list[Branch]] = []
         for piece, state in enumerate(system.states):
-            if piece == 0 and arc is not None:  # the stretched arc solves this piece itself
-                particular.append([Branch(domain)])
+            if (piece == 0 and top is not None) or (piece == last_piece and bottom is not None):
+                particular.append([Branch(domain)])  # the stretched arc solves this piece itself
                 continue
             components = []
             for k in range(size):
@@ -483,8 +504,8 @@ class BranchHierarchy(LazyOrders):
             point = boundary.point
             powers = self._shift_powers(index, order)
             left, right = index, index + 1
-            if index == 0 and arc is not None:
-                c_next, d_next, quotient = self._match_arc(order, point, boundary, powers, value_of, constant, unit)
+            if index == 0 and top is not None:
+                c_next, d_next, top_quotient = self._match_first_arc(order, point, boundary, powers, value_of, constant, unit)
                 c_values.append(c_next)
                 d_values.append(d_next)
                 shift_values.append(unit(1))
@@ -506,6 +527,8 @@ class BranchHierarchy(LazyOrders):
                 shift_values.append(gap.scale(-one / (boundary.coupling[mode] * curvature * boundary.first_shift)))
             else:
                 shift_values.append(None)
+            if right == last_piece and bottom is not None:
+                break  # the last arc is matched below (slope and frequency conditions)
             # C¹ matching of every component: the homogeneous parts of the right piece.
             c_next, d_next = [], []
             for k in range(size):
@@ -520,10 +543,19 @@ class BranchHierarchy(LazyOrders):
                 d_next.append(x.scale(sine) + y.scale(cosine / ratios[k]))
             c_values.append(c_next)
             d_values.append(d_next)
-        last = len(system.states) - 1
-        equations = [value_of(last, k, c_values[last][k], d_values[last][k], system.pi_point, True) for k in range(size)]
-        if arc is not None:  # the release is the arc's; the unknowns are tied by A_n = [μ s*²]_n
-            equations.append(self._arc_frequency_condition(order, unit))
+        last = last_piece
+        if bottom is None:
+            equations = [value_of(last, k, c_values[last][k], d_values[last][k], system.pi_point, True) for k in range(size)]
+        else:
+            index = len(system.boundaries) - 1
+            bottom_mu, bottom_quotient, slope_condition = self._match_last_arc(
+                order, system.boundaries[index], self._shift_powers(index, order), shift_values[index],
+                value_of(last - 1, 0, c_values[last - 1][0], d_values[last - 1][0], system.boundaries[index].point, True),
+                constant, unit(turning),
+            )
+            equations = [slope_condition, self._arc_frequency_condition(1, order, bottom_mu, shift_values[index].scale(-domain.one), unit)]
+        if top is not None:  # the release is the arc's; the unknowns are tied by A_n = [μ s_1*²]_n
+            equations.append(self._arc_frequency_condition(0, order, constant(self._arc_data[0]["mu"][order]), unit(1), unit))
         elif self.normalization == "initial":
             release = value_of(0, mode, c_values[0][mode], d_values[0][mode], system.zero_point, False)
             prescribed = system.release_at(order)
@@ -533,7 +565,7 @@ class BranchHierarchy(LazyOrders):
         unknowns = solve_linear([list(e.coefficients) for e in equations], [-e.base for e in equations], domain, order)
         branches = []
         for piece in range(len(system.states)):
-            if piece == 0 and arc is not None:
+            if (piece == 0 and top is not None) or (piece == last_piece and bottom is not None):
                 branches.append([Branch(domain)])  # the arc's own representation (StretchedArc) stands here
                 continue
             components = []
@@ -553,30 +585,34 @@ class BranchHierarchy(LazyOrders):
         for shifts, value in zip(self._shifts, shift_values):
             if value is not None:
                 shifts.append(value.value(unknowns))
-        if arc is not None:
-            self._arc_quotients.append(quotient.value(unknowns))
+        if top is not None:
+            self._arc_data[0]["quotient"].append(top_quotient.value(unknowns))
+            self._arc_data[0]["length"].append(unknowns[1])
+        if bottom is not None:
+            data = self._arc_data[1]
+            data["mu"].append(bottom_mu.value(unknowns))
+            data["quotient"].append(bottom_quotient.value(unknowns))
+            data["length"].append(-self._shifts[-1][order])
+            bottom.fix(order, unknowns[turning])
         self.counters["orders"] += 1
 
-    def _arc_coefficients(self, order: int) -> tuple[Any, Any]:
-        """(μ_order, Y_order'(1)) of the stretched arc, as domain elements."""
-        mu, slope = self.system.arc.coefficients(order)
-        # RealField.dtype keeps every digit of an mpf (RealField.convert goes through a float)
-        return self._domain.dtype(mu), self._domain.dtype(slope)
+    def _match_first_arc(self, order: int, point: EvaluationPoint, boundary: MovingBoundary, powers: list, value_of: Any, constant: Any, unit: Any) -> tuple:
+        """The next piece's homogeneous parts from the first arc's end: W(s*) = κ, W'(s*) = Y'(1)/s*, at order n.
 
-    def _match_arc(self, order: int, point: EvaluationPoint, boundary: MovingBoundary, powers: list, value_of: Any, constant: Any, unit: Any) -> tuple:
-        """The next piece's homogeneous parts from the arc's end: W(s*) = κ and W'(s*) = Y'(1)/s*, at order n.
-
-        Unknowns: A_n (index 0) and σ_n (index 1).  W_0 = cos s, so the σ_n terms at β are
-        W_0'(β) σ_n = −sin β σ_n (value) and W_0''(β) σ_n = −κ σ_n (slope);
-        Q = Y'(1)/s* gives Q_n = (P_n − Σ_{j=1}^{n−1} σ_j Q_{n−j} − σ_n Q_0)/β, Q_0 = −sin β.
+        The arc is released at its prescribed w_n, so μ_n and P_n = Y_n'(1) are numbers.  Unknowns:
+        A_n (index 0) and σ_n (index 1).  W_0 = cos s, so the σ_n terms at β are W_0'(β) σ_n = −sin β σ_n
+        (value) and W_0''(β) σ_n = −κ σ_n (slope); Q = Y'(1)/s* gives
+        Q_n = (P_n − Σ_{j=1}^{n−1} σ_j Q_{n−j} − σ_n Q_0)/β, Q_0 = −sin β.
         """
-        domain = self._domain
+        domain, arc, data = self._domain, self.system.arcs[0], self._arc_data[0]
+        release = self.system.release_at(order)
+        arc.fix(order, domain.zero if release is None else release)
+        # RealField.dtype keeps every digit of an mpf (RealField.convert goes through a float)
+        data["mu"].append(domain.dtype(arc.mu(order)))
         sine, cosine, beta = boundary.sine, point.cos_multiple(1), point.value
-        _, slope = self._arc_coefficients(order)
-        shifts = self._shifts[0]
-        known_quotient = slope
+        known_quotient = domain.dtype(arc.slope(order))
         for j in range(1, order):
-            known_quotient = known_quotient - shifts[j] * self._arc_quotients[order - j]
+            known_quotient = known_quotient - data["length"][j] * data["quotient"][order - j]
         quotient = constant(known_quotient / beta) + unit(1).scale(sine / beta)
         value = unit(1).scale(sine).shift(-self._known(0, 1, 0, order, 0, powers))
         slope_target = (quotient + unit(1).scale(cosine)).shift(-self._known(0, 1, 0, order, 1, powers))
@@ -584,20 +620,39 @@ class BranchHierarchy(LazyOrders):
         y = slope_target - value_of(1, 0, constant(domain.zero), constant(domain.zero), point, True)
         return [x.scale(cosine) - y.scale(sine)], [x.scale(sine) + y.scale(cosine)], quotient
 
-    def _arc_frequency_condition(self, order: int, unit: Any) -> _Affine:
-        """A_n − [μ s*²]_n = 0 (μ = Ω²/s*², s* = β + Σ σ_j ε̂^j), affine in (A_n, σ_n)."""
-        domain = self._domain
-        shifts = self._shifts[0]
-        beta = shifts[0]
+    def _match_last_arc(self, order: int, boundary: MovingBoundary, powers: list, shift: _Affine, left_slope: _Affine,
+                        constant: Any, turning: _Affine) -> tuple:
+        """μ_n and Q_n of the last arc (affine in its turning value h_n), and the slope condition at s_L*.
 
-        def squared(j: int) -> Any:  # [s*²]_j for j < order
-            return sum((shifts[i] * shifts[j - i] for i in range(j + 1)), domain.zero)
+        On the last piece W(s) = −Y((π − s)/ℓ), ℓ = π − s_L*, so W'(s_L*) = Y'(1)/ℓ = Q; ℓ_n = −σ_{L,n}.
+        The left piece's slope at the moving point is its W_n'(β) + known Taylor terms + W_0''(β) σ_n.
+        """
+        domain, arc, data = self._domain, self.system.arcs[1], self._arc_data[1]
+        mu_constant, mu_per_h, slope_constant, slope_per_h = (domain.dtype(value) for value in arc.response(order))
+        mu = constant(mu_constant) + turning.scale(mu_per_h)
+        slope = constant(slope_constant) + turning.scale(slope_per_h)
+        length = data["length"]
+        for j in range(1, order):
+            slope = slope.shift(-length[j] * data["quotient"][order - j])
+        # −ℓ_n Q_0 = σ_n Q_0 = −σ_n sin β
+        quotient = (slope + shift.scale(-boundary.sine)).scale(domain.one / length[0])
+        index = len(self.system.boundaries) - 1
+        left = left_slope.shift(self._known(index, len(self.system.states) - 2, 0, order, 1, powers))
+        left = left + shift.scale(-boundary.point.cos_multiple(1))
+        return mu, quotient, left - quotient
 
-        known = sum((shifts[i] * shifts[order - i] for i in range(1, order)), domain.zero)
-        mu_zero = domain.one / (beta * beta)
-        total = unit(1).scale(2 * beta * mu_zero).shift(known * mu_zero)
-        for i in range(1, order + 1):
-            total = total.shift(self._arc_coefficients(i)[0] * squared(order - i))
+    def _arc_frequency_condition(self, which: int, order: int, mu: _Affine, length_shift: _Affine, unit: Any) -> _Affine:
+        """A_n − [μ ℓ²]_n = 0 for arc ``which`` (μ = Ω²/ℓ²), given μ_n and ℓ_n as affine values."""
+        domain, data = self._domain, self._arc_data[which]
+        lengths, mus = data["length"], data["mu"]
+
+        def squared(j: int) -> Any:  # [ℓ²]_j for j < order
+            return sum((lengths[i] * lengths[j - i] for i in range(j + 1)), domain.zero)
+
+        known = sum((lengths[i] * lengths[order - i] for i in range(1, order)), domain.zero)
+        total = length_shift.scale(2 * lengths[0] * mus[0]).shift(known * mus[0]) + mu.scale(squared(0))
+        for i in range(1, order):
+            total = total.shift(mus[i] * squared(order - i))
         return unit(0) - total
 
     def _first_harmonic_condition(self, order: int, particular: list, c_values: list, d_values: list, resonant_unit: _Affine) -> _Affine:

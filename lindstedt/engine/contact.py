@@ -271,40 +271,52 @@ def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hi
     return form
 
 
-def _stretched_arc(problem: Oscillator, w_intervals: list, interval_of: list[int], fractional_pieces: list[int],
-                   crossing_kappas: list[sympy.Expr], grazing: list, field: "_ConstantField", releases: list) -> StretchedArc:
-    """The first piece as a stretched arc (a fractional power law c (w − κ)^p about the release point)."""
+def _stretched_arcs(problem: Oscillator, w_intervals: list, interval_of: list[int], fractional_pieces: list[int],
+                    crossing_kappas: list[sympy.Expr], grazing: list, field: "_ConstantField") -> tuple:
+    """(first, last): the pieces with a fractional power law c |w − κ|^p as stretched arcs, or None.
+
+    The first piece holds the release point w = 1, the last one the far turning point; there the arc is
+    read backwards, Y = −W, whose law is −f̂(−Y) = −Σ c_m (−Y)^m − c (Y + κ)^p (contact point −κ).
+    """
     supported = (
-        "a fractional power law (Hertz c*Max(0, u - b)**(3/2)) is supported on the contact arc that contains "
-        "the release point, with the other pieces polynomial: release the oscillator on the contact side "
-        "(a0 inside the contact) and give numeric values"
+        "a fractional power law (Hertz c*Max(0, u - b)**(3/2)) is supported on a contact arc that holds a "
+        "turning point of the orbit (u = a0 or the far side), with the other pieces polynomial; give numeric values"
     )
-    fractional = w_intervals[interval_of[0]][3]
-    if fractional_pieces != [0] or len(fractional) != 1 or grazing or not crossing_kappas:
+    last = len(interval_of) - 1
+    if grazing or not crossing_kappas or any(piece not in (0, last) for piece in fractional_pieces):
         raise UnsupportedNonlinearityError(f"f = {problem.f}: {supported}")
-    coefficient, kappa, exponent = fractional[0]
-    top_kappa = max(crossing_kappas, key=lambda k: k if k.is_number else 0)
-    if sympy.simplify(kappa - top_kappa) != 0 or not kappa.is_number or not coefficient.is_number:
-        raise UnsupportedNonlinearityError(f"f = {problem.f}: {supported}")
+    if fractional_pieces == [0, last] and len(crossing_kappas) < 2:
+        raise UnsupportedNonlinearityError(f"f = {problem.f}: fractional laws on both sides of one breakpoint; {supported}")
     if problem.normalization != "initial":
         raise UnsupportedNonlinearityError(f"f = {problem.f}: a fractional power law needs normalization='initial' (a0 is the release point)")
     if not field.numeric:
         raise ProblemError(f"f = {problem.f}: a fractional power law is expanded numerically; pass numeric=True (and precision=...)")
     digits = field.digits + 10
+    ordered = sorted(crossing_kappas, key=lambda k: -k if k.is_number else 0)
 
     def number(value: sympy.Expr) -> mpmath.mpf:
+        if not value.is_number:
+            raise UnsupportedNonlinearityError(f"f = {problem.f}: {supported} (got the symbolic {value})")
         with mpmath.workdps(digits):
             return mpmath.mpf(sympy.N(value, digits))
 
-    releases_mp = [number(value) for value in releases]
-    return StretchedArc(
-        number(kappa),
-        Fraction(int(exponent.p), int(exponent.q)),
-        number(coefficient),
-        [number(value) for value in w_intervals[interval_of[0]][2]],
-        lambda order: releases_mp[order - 1] if 1 <= order <= len(releases_mp) else None,
-        field.digits,
-    )
+    arcs = []
+    for which, piece in enumerate((0, last)):
+        fractional = w_intervals[interval_of[piece]][3]
+        if piece not in fractional_pieces:
+            arcs.append(None)
+            continue
+        boundary = ordered[0] if which == 0 else ordered[-1]
+        if len(fractional) != 1 or sympy.simplify(fractional[0][1] - boundary) != 0:
+            raise UnsupportedNonlinearityError(f"f = {problem.f}: {supported}")
+        coefficient, kappa, exponent = fractional[0]
+        polynomial = list(w_intervals[interval_of[piece]][2])
+        if which == 1:  # Y = −W (negated exactly: an mpf negated outside workdps would be rounded to 15 digits)
+            coefficient, kappa = -coefficient, -kappa
+            polynomial = [-value if power % 2 == 0 else value for power, value in enumerate(polynomial)]
+        polynomial = [number(value) for value in polynomial]
+        arcs.append(StretchedArc(number(kappa), Fraction(int(exponent.p), int(exponent.q)), number(coefficient), polynomial, field.digits))
+    return tuple(arcs)
 
 
 def _assemble(
@@ -342,7 +354,7 @@ def _assemble(
     field = _ConstantField(values, digits)
     domain = field.domain
     piece_laws = [tuple(field.convert(value) for value in w_intervals[interval_index][2]) for interval_index in interval_of]
-    arc = _stretched_arc(problem, w_intervals, interval_of, fractional_pieces, crossing_kappas, grazing, field, releases) if fractional_pieces else None
+    arcs = _stretched_arcs(problem, w_intervals, interval_of, fractional_pieces, crossing_kappas, grazing, field) if fractional_pieces else (None, None)
     zero = EvaluationPoint(domain, domain.zero, domain.one, domain.zero)
     pi_point = EvaluationPoint(domain, field.convert(sympy.pi), -domain.one, domain.zero)
     boundaries, moving = [], []
@@ -373,7 +385,7 @@ def _assemble(
         pi_point=pi_point,
         release=tuple(field.convert(release) for release in releases),
         gauge=gauge,
-        arc=arc,
+        arcs=arcs,
     )
     if grazing:
         regime = "grazing"

@@ -1,7 +1,9 @@
 """A contact arc under a fractional power law, on a fixed interval (Hertz contact and its kin).
 
-Problem: the first piece ``s ∈ [0, s*(ε̂))`` of the branch hierarchy (N = 1, see
-:mod:`lindstedt.engine.branches`), on which the normalised law is
+Problem: a piece of the branch hierarchy (N = 1, see :mod:`lindstedt.engine.branches`)
+that holds a turning point — the first piece ``s ∈ [0, s*(ε̂))`` (the release point),
+or the last one ``(s*(ε̂), π]`` read backwards (τ = (π − s)/(π − s*), W = −Y) — on which
+the normalised law is
 
     Ω² W'' + W + ε̂ f̂(W) = 0,   f̂(W) = Σ_m c_m W^m + c (W − κ)^p,   W > κ,
 
@@ -11,7 +13,7 @@ W'' ~ (s* − s)^p), and that point moves with ε̂: Lindstedt coefficients W_n(
 fixed s would diverge there from the order where p − n < −1.  So the arc is mapped
 to a fixed interval: ``τ = s/s*(ε̂) ∈ [0, 1]``, ``Y(τ) = W(s* τ)``, ``μ = Ω²/s*²``:
 
-    μ Y'' + Y + ε̂ f̂(Y) = 0,   Y'(0) = 0,   Y(0) = 1 + Σ w_n ε̂^n (the release),   Y(1) = κ,
+    μ Y'' + Y + ε̂ f̂(Y) = 0,   Y'(0) = 0,   Y(0) = 1 + Σ h_n ε̂^n,   Y(1) = κ,
 
 and the contact point stays at τ = 1 for every ε̂.  With ``Y = Σ ε̂^n Y_n``,
 ``Y_0 = cos βτ``, ``β = arccos κ``, ``μ = Σ μ_n ε̂^n``, ``μ_0 = 1/β²``, the vanishing
@@ -25,10 +27,13 @@ expanded by the recurrence for powers of a power series.  Order n ≥ 1 reads
 
 solved by variation of parameters from τ = 0 (ĝ_n is g_n without its μ_n term),
 
-    Y_n = w_n cos βτ + (β³ μ_n/2) τ sin βτ + (1/β)[sin βτ ∫_0^τ cos βt ĝ_n dt − cos βτ ∫_0^τ sin βt ĝ_n dt],
+    Y_n = h_n cos βτ + (β³ μ_n/2) τ sin βτ + (1/β)[sin βτ ∫_0^τ cos βt ĝ_n dt − cos βτ ∫_0^τ sin βt ĝ_n dt],
 
-with μ_n from the contact condition Y_n(1) = 0.  The branch hierarchy takes μ_n and the
-slope Y_n'(1) to match the next piece (``s*² = Ω²/μ``).
+with μ_n from the contact condition Y_n(1) = 0: μ_n and the end slope Y_n'(1) are affine in
+the turning-point value h_n (:meth:`StretchedArc.response`).  At the release point h_n is
+the prescribed w_n; at the far turning point it is an unknown of the branch hierarchy,
+which ties μ to Ω and the arc's length (``length² = Ω²/μ``), matches the neighbouring piece
+to the arc's end and hands h_n back (:meth:`StretchedArc.fix`).
 
 **Representation.**  Every Y_n is analytic in ``v = (1 − τ)^{1/d}`` on [0, 1] (the
 powers (1 − τ)^{k/d} that the contact point brings are powers of v, and τ = 1 − v^d),
@@ -78,35 +83,35 @@ class StretchedArc:
     Parameters
     ----------
     kappa : number
-        The contact point κ (|κ| < 1) of the normalised displacement.
+        The contact point κ (|κ| < 1) of Y.
     exponent : Fraction
         p = q/d > 0, not an integer.
     coefficient : number
-        c of the fractional term c (W − κ)^p.
+        c of the fractional term c (Y − κ)^p.
     polynomial : sequence of numbers
         c_0, c_1, … of the polynomial part of the law on the arc.
-    release : callable order -> number or None
-        w_n = Y_n(0) (None: 0).
     digits : int
         Decimal digits wanted.
 
     Examples
     --------
     >>> from fractions import Fraction
-    >>> arc = StretchedArc(0, Fraction(3, 2), 1, (), lambda n: None, 20)
-    >>> mu, slope = arc.coefficients(1)
-    >>> abs(mu) > 0
+    >>> arc = StretchedArc(0, Fraction(3, 2), 1, (), 20)
+    >>> mu_constant, mu_per_h, slope_constant, slope_per_h = arc.response(1)
+    >>> arc.fix(1, 0)                       # released at Y(0) = 1 exactly
+    >>> arc.mu(1) == mu_constant
     True
     """
 
-    def __init__(self, kappa: Any, exponent: Fraction, coefficient: Any, polynomial: Sequence[Any], release: Any, digits: int):
+    def __init__(self, kappa: Any, exponent: Fraction, coefficient: Any, polynomial: Sequence[Any], digits: int):
         if exponent <= 0 or exponent.denominator == 1:
             raise ValueError("the stretched arc is for non-integer exponents p > 0")
         self.exponent = exponent
         self.denominator = exponent.denominator
         self.digits = digits
         self._working = digits + _GUARD_DIGITS
-        self._release = release
+        self._turning: list[Any] = [mpmath.mpf(1)]  # h_n = Y_n(0) as fixed so far
+        self._pending: tuple[int, dict] | None = None
         with mpmath.workdps(self._working):
             self.kappa = mpmath.mpf(kappa)
             self.coefficient = mpmath.mpf(coefficient)
@@ -198,9 +203,9 @@ class StretchedArc:
             total = [t + value * x for t, x in zip(total, term)]
         return total
 
-    def _solve(self, order: int) -> None:
-        M, beta = self.nodes, self.beta
-        p = mpmath.mpf(self.exponent.numerator) / self.exponent.denominator
+    def _particular(self, order: int) -> dict:
+        """The part of Y_order that lower orders fix: ĝ, the variation-of-parameters integrals, Y_p(1), Y_p'(1)."""
+        beta = self.beta
         law = self._law(order - 1)
         forcing = [-beta * beta * value for value in law]
         for i in range(1, order):
@@ -210,12 +215,30 @@ class StretchedArc:
         integrand_sin = [j * s * g for j, s, g in zip(self._jacobian, self._sin, forcing)]
         cos_integral, cos_total = self._integral_to_end(integrand_cos)
         sin_integral, sin_total = self._integral_to_end(integrand_sin)
-        release = self._release(order)
-        release = mpmath.mpf(0) if release is None else mpmath.mpf(release)
         sin_b, cos_b = mpmath.sin(beta), mpmath.cos(beta)
-        particular_end = (sin_b * cos_total - cos_b * sin_total) / beta
+        coefficients = self._coefficients(integrand_cos)
+        scale = max(abs(a) for a in coefficients) or mpmath.mpf(1)
+        return {
+            "forcing": forcing, "cos": cos_integral, "sin": sin_integral,
+            "end": (sin_b * cos_total - cos_b * sin_total) / beta, "end_slope": cos_b * cos_total + sin_b * sin_total,
+            "tail": max(abs(a) for a in coefficients[-4:]) / scale,
+        }
+
+    def _response(self, data: dict) -> tuple[Any, Any, Any, Any]:
+        beta = self.beta
+        sin_b, cos_b = mpmath.sin(beta), mpmath.cos(beta)
         resonant = beta**3 / 2
-        mu = -(release * cos_b + particular_end) / (resonant * sin_b)
+        mu_constant, mu_per_h = -data["end"] / (resonant * sin_b), -cos_b / (resonant * sin_b)
+        growth = resonant * (sin_b + beta * cos_b)
+        return mu_constant, mu_per_h, data["end_slope"] + growth * mu_constant, -beta * sin_b + growth * mu_per_h
+
+    def _solve(self, order: int, release: Any, data: dict) -> None:
+        M, beta = self.nodes, self.beta
+        p = mpmath.mpf(self.exponent.numerator) / self.exponent.denominator
+        forcing, cos_integral, sin_integral = data["forcing"], data["cos"], data["sin"]
+        resonant = beta**3 / 2
+        mu_constant, mu_per_h, slope_constant, slope_per_h = self._response(data)
+        mu = mu_constant + mu_per_h * release
         values, slopes, second = [], [], []
         for i in range(M):
             t, c, s = self._tau[i], self._cos[i], self._sin[i]
@@ -225,7 +248,7 @@ class StretchedArc:
             values.append(value)
             slopes.append(-release * beta * s + resonant * mu * (s + beta * t * c) + particular_slope)
             second.append(forcing[i] + beta**4 * mu * c - beta * beta * value)
-        end_slope = -release * beta * sin_b + resonant * mu * (sin_b + beta * cos_b) + cos_b * cos_total + sin_b * sin_total
+        end_slope = slope_constant + slope_per_h * release
         self._values.append(values)
         self._second.append(second)
         self._ratios.append([y / g for y, g in zip(values, self._gap)])
@@ -240,29 +263,62 @@ class StretchedArc:
         scale = max(abs(a) for a in value_series) or mpmath.mpf(1)
         self.tail = max(self.tail, max(abs(a) for a in value_series[-4:]) / scale)
 
-    def _ensure(self, order: int) -> None:
-        tolerance = mpmath.mpf(10) ** (-(self.digits + 2))
-        while len(self._mu) <= order:
+    def _refine(self, order: int) -> None:
+        """Double the Chebyshev points and redo orders 1 … order − 1 with their fixed h_n."""
+        if 2 * self.nodes > _MAXIMUM_NODES:
+            raise ConvergenceError(
+                f"the stretched contact arc needs more than {_MAXIMUM_NODES} Chebyshev points "
+                f"for {self.digits} digits at order {order} (tail {mpmath.nstr(self.tail, 3)}); "
+                "ask for fewer digits or a lower order"
+            )
+        self.nodes *= 2
+        self.counters["restarts"] += 1
+        self._reset()
+        for n in range(1, order):
             with mpmath.workdps(self._working):
-                self._solve(len(self._mu))
-            self.counters["orders"] += 1
-            if self.tail > tolerance:
-                if 2 * self.nodes > _MAXIMUM_NODES:
-                    raise ConvergenceError(
-                        f"the stretched contact arc needs more than {_MAXIMUM_NODES} Chebyshev points "
-                        f"for {self.digits} digits at order {len(self._mu) - 1} (tail {mpmath.nstr(self.tail, 3)}); "
-                        "ask for fewer digits or a lower order"
-                    )
-                reached = len(self._mu) - 1
-                self.nodes *= 2
-                self.counters["restarts"] += 1
-                self._reset()
-                self._ensure(reached)
+                self._solve(n, self._turning[n], self._particular(n))
 
-    def coefficients(self, order: int) -> tuple[Any, Any]:
-        """(μ_order, Y_order'(1)) as mpf numbers."""
-        self._ensure(order)
-        return self._mu[order], self._slope[order]
+    def response(self, order: int) -> tuple[Any, Any, Any, Any]:
+        """``(μ_c, μ_h, S_c, S_h)`` with μ_order = μ_c + μ_h h and Y_order'(1) = S_c + S_h h, h = Y_order(0).
+
+        Orders below ``order`` must be fixed (:meth:`fix`); the Chebyshev grid is refined until
+        the order's forcing is resolved to the working precision.
+        """
+        if order != len(self._mu):
+            raise ValueError(f"order {order} of the stretched arc is not the next one ({len(self._mu)})")
+        tolerance = mpmath.mpf(10) ** (-(self.digits + 2))
+        while True:
+            with mpmath.workdps(self._working):
+                data = self._particular(order)
+            if max(data["tail"], self.tail) <= tolerance:
+                break
+            self._refine(order)
+        self._pending = (order, data)
+        with mpmath.workdps(self._working):
+            return self._response(data)
+
+    def fix(self, order: int, turning_value: Any) -> None:
+        """Complete Y_order with its turning-point value h = Y_order(0)."""
+        if self._pending is None or self._pending[0] != order:
+            self.response(order)
+        with mpmath.workdps(self._working):
+            value = mpmath.mpf(turning_value)
+            self._solve(order, value, self._pending[1])
+        self._turning.append(value)
+        self._pending = None
+        self.counters["orders"] += 1
+
+    def mu(self, order: int) -> Any:
+        """μ_order (fixed orders only)."""
+        return self._mu[order]
+
+    def slope(self, order: int) -> Any:
+        """Y_order'(1) (fixed orders only)."""
+        return self._slope[order]
+
+    def _ensure(self, order: int) -> None:
+        if len(self._mu) <= order:
+            raise ValueError(f"order {order} of the stretched arc is not fixed yet")
 
     def float_arc(self, highest: int) -> FloatArc:
         """The float evaluator of Y_0 … Y_highest."""
