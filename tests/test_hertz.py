@@ -1,4 +1,5 @@
-"""Fractional power laws (Hertz contact c (u − b)_+^{3/2}) on the branch engine's stretched contact arc (issue 12).
+"""Non-polynomial contact laws on the branch engine's stretched contact arcs (issue 12): fractional powers
+(Hertz contact c (u − b)_+^{3/2}) and analytic laws (c (u − b)_+ e^u) on an arc that holds a turning point.
 
 References, none of them the code under test:
 
@@ -43,11 +44,15 @@ def test_amplitude_scaling_is_exact():
     [
         ("Max(0, u)**(3/2)", 1),
         ("Max(0, u - 1/5)**(3/2)", 1),
-        ("Max(0, u + 1/2)**(3/2)", 1),
-        ("2*Max(0, u - 1/5)**(3/2) + u**3", "0.8"),
+        pytest.param("Max(0, u + 1/2)**(3/2)", 1, marks=pytest.mark.slow),
+        pytest.param("2*Max(0, u - 1/5)**(3/2) + u**3", "0.8", marks=pytest.mark.slow),
         ("Max(0, u)**(3/2)", -1),  # the contact holds the far turning point
-        ("Max(0, u - 1/5)**(3/2) + Max(0, -u - 1/5)**(3/2)", 1),  # two-sided Hertz with a clearance
-        ("Max(0, u - 1/5)**(3/2) + 2*Max(0, -u - 1/3)**(5/2) + u**2", "0.9"),  # asymmetric, polynomial between
+        pytest.param("Max(0, u - 1/5)**(3/2) + Max(0, -u - 1/5)**(3/2)", 1, marks=pytest.mark.slow),  # two-sided, clearance
+        pytest.param("Max(0, u - 1/5)**(3/2) + 2*Max(0, -u - 1/3)**(5/2) + u**2", "0.9", marks=pytest.mark.slow),
+        ("Max(0, u - 1/5)*exp(u)", 1),  # an analytic contact law
+        pytest.param("exp(Max(0, u)) - 1", 1, marks=pytest.mark.slow),
+        pytest.param("Max(0, u)**(3/2) + Heaviside(u)*sin(u)**2", 1, marks=pytest.mark.slow),  # both on one arc
+        pytest.param("Max(0, u)*exp(u)", -1, marks=pytest.mark.slow),  # analytic, on the far side
     ],
 )
 def test_omega_1_to_4_match_the_taylor_coefficients_of_the_exact_period(f, a0):
@@ -68,7 +73,7 @@ def test_float_mode_is_accurate_to_1e_12():
 @pytest.mark.parametrize(
     "f, a0, order",
     [("Max(0, u)**(3/2)", 1, 1), ("Max(0, u)**(3/2)", 1, 3), ("Max(0, u - 1/5)**(3/2)", 1, 2), ("Max(0, u)**(3/2)", -1, 2),
-     ("Max(0, u - 1/5)**(3/2) + Max(0, -u - 1/5)**(3/2)", 1, 3)],
+     ("Max(0, u - 1/5)**(3/2) + Max(0, -u - 1/5)**(3/2)", 1, 3), ("Max(0, u - 1/5)*exp(u)", 1, 2)],
 )
 def test_waveform_error_over_one_over_eps_has_slope_order_plus_one(f, a0, order):
     expansion = lindstedt.expand(f, order=order, a0=a0, omega0=1, precision=20)
@@ -104,3 +109,7 @@ def test_what_the_stretched_arc_does_not_cover_is_refused_with_the_fix():
         lindstedt.expand("Max(0, u)**(-1/2)", order=2, a0=1, omega0=1)
     with pytest.raises(lindstedt.UnsupportedNonlinearityError, match="rational"):
         lindstedt.expand("Max(0, u)**pi", order=2, a0=1, omega0=1)
+    with pytest.raises(lindstedt.UnsupportedNonlinearityError, match="holds a turning point"):  # analytic law mid-orbit
+        lindstedt.expand("Max(0, u - 1/5)*exp(u)*Heaviside(1/2 - u)", order=2, a0=1, omega0=1)
+    with pytest.raises(lindstedt.UnsupportedNonlinearityError, match="not linear in u"):  # infinitely many breakpoints
+        lindstedt.expand("Heaviside(sin(1/u))", order=2, a0=1, omega0=1)

@@ -71,11 +71,15 @@ def test_waveform_error_over_one_over_eps_has_slope_order_plus_one(f, order):
 
 
 def test_unsupported_pieces_name_what_is_supported():
-    with pytest.raises(lindstedt.UnsupportedNonlinearityError, match="not piecewise polynomial"):
-        lindstedt.expand("Piecewise((exp(u), u > 0), (0, True))", order=2, a0=1, omega0=1)
+    with pytest.raises(lindstedt.UnsupportedNonlinearityError, match="not analytic on the whole arc"):
+        lindstedt.expand("Max(0, u)*log(u)", order=2, a0=1, omega0=1)
 
 
-@pytest.mark.parametrize("f", ["Max(0, u)**2", "u*Abs(u)", "Max(0, u - 1/3)**2", "Heaviside(u - 1/2)*u**2", "Max(0, u + 1/2)**2 + u**3"])
+@pytest.mark.parametrize(
+    "f",
+    ["Max(0, u)**2", "Max(0, u - 1/3)**2", pytest.param("u*Abs(u)", marks=pytest.mark.slow),
+     pytest.param("Heaviside(u - 1/2)*u**2", marks=pytest.mark.slow), pytest.param("Max(0, u + 1/2)**2 + u**3", marks=pytest.mark.slow)],
+)
 def test_omega_1_to_5_match_the_taylor_coefficients_of_the_exact_period(f):
     expansion = lindstedt.expand(f, order=5, a0=1, omega0=1)
     reference = frequency_taylor_coefficients(expansion.problem.nonlinearity, 5, a0=1, omega0=1, precision=30)

@@ -41,6 +41,8 @@ from .stretched import StretchedArc
 
 __all__ = ["ContactBoundary", "PiecewiseNormalForm", "contact_normal_form"]
 
+_ARC_VARIABLE = sympy.Symbol("y", real=True)  # the normalised displacement in an arc's analytic law
+
 
 @dataclass(frozen=True)
 class ContactBoundary:
@@ -207,11 +209,12 @@ def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hi
             (coefficient * abs(amplitude) ** exponent / amplitude, point / amplitude, exponent)
             for coefficient, point, exponent in interval.fractional
         )
-        w_intervals.append((lower, upper, law, fractional))
+        analytic = interval.analytic.subs(DISPLACEMENT, amplitude * _ARC_VARIABLE) / amplitude  # g(w) = g_u(a0 w)/a0
+        w_intervals.append((lower, upper, law, fractional, analytic))
     if sign < 0:
         w_intervals.reverse()
     # Breakpoints in w, increasing; classify each against the orbit [-1, 1].
-    kappas = [upper for (_, upper, _, _) in w_intervals[:-1]]
+    kappas = [upper for (_, upper, _, _, _) in w_intervals[:-1]]
     crossing: list[int] = []
     grazing: list[sympy.Expr] = []
     classes: list[tuple[sympy.Expr, str]] = []
@@ -279,8 +282,9 @@ def _stretched_arcs(problem: Oscillator, w_intervals: list, interval_of: list[in
     read backwards, Y = −W, whose law is −f̂(−Y) = −Σ c_m (−Y)^m − c (Y + κ)^p (contact point −κ).
     """
     supported = (
-        "a fractional power law (Hertz c*Max(0, u - b)**(3/2)) is supported on a contact arc that holds a "
-        "turning point of the orbit (u = a0 or the far side), with the other pieces polynomial; give numeric values"
+        "a fractional power law (Hertz c*Max(0, u - b)**(3/2)) or a non-polynomial analytic law is supported on a "
+        "contact arc that holds a turning point of the orbit (u = a0 or the far side), with the other pieces "
+        "polynomial; give numeric values"
     )
     last = len(interval_of) - 1
     if grazing or not crossing_kappas or any(piece not in (0, last) for piece in fractional_pieces):
@@ -290,7 +294,7 @@ def _stretched_arcs(problem: Oscillator, w_intervals: list, interval_of: list[in
     if problem.normalization != "initial":
         raise UnsupportedNonlinearityError(f"f = {problem.f}: a fractional power law needs normalization='initial' (a0 is the release point)")
     if not field.numeric:
-        raise ProblemError(f"f = {problem.f}: a fractional power law is expanded numerically; pass numeric=True (and precision=...)")
+        raise ProblemError(f"f = {problem.f}: a non-polynomial contact law is expanded numerically; pass numeric=True (and precision=...)")
     digits = field.digits + 10
     ordered = sorted(crossing_kappas, key=lambda k: -k if k.is_number else 0)
 
@@ -302,21 +306,42 @@ def _stretched_arcs(problem: Oscillator, w_intervals: list, interval_of: list[in
 
     arcs = []
     for which, piece in enumerate((0, last)):
-        fractional = w_intervals[interval_of[piece]][3]
+        _, _, polynomial, fractional, analytic = w_intervals[interval_of[piece]]
         if piece not in fractional_pieces:
             arcs.append(None)
             continue
-        boundary = ordered[0] if which == 0 else ordered[-1]
-        if len(fractional) != 1 or sympy.simplify(fractional[0][1] - boundary) != 0:
+        kappa = ordered[0] if which == 0 else ordered[-1]
+        if len(fractional) > 1 or (fractional and sympy.simplify(fractional[0][1] - kappa) != 0):
             raise UnsupportedNonlinearityError(f"f = {problem.f}: {supported}")
-        coefficient, kappa, exponent = fractional[0]
-        polynomial = list(w_intervals[interval_of[piece]][2])
+        coefficient, exponent = (fractional[0][0], fractional[0][2]) if fractional else (sympy.S.Zero, None)
+        polynomial = list(polynomial)
         if which == 1:  # Y = −W (negated exactly: an mpf negated outside workdps would be rounded to 15 digits)
             coefficient, kappa = -coefficient, -kappa
             polynomial = [-value if power % 2 == 0 else value for power, value in enumerate(polynomial)]
+            analytic = -analytic.subs(_ARC_VARIABLE, -_ARC_VARIABLE)
+        if analytic.free_symbols - {_ARC_VARIABLE}:
+            raise UnsupportedNonlinearityError(f"f = {problem.f}: {supported} (got the symbols {analytic.free_symbols - {_ARC_VARIABLE}})")
+        if analytic != 0:
+            _check_analytic_on_arc(analytic, kappa, problem)
         polynomial = [number(value) for value in polynomial]
-        arcs.append(StretchedArc(number(kappa), Fraction(int(exponent.p), int(exponent.q)), number(coefficient), polynomial, field.digits))
+        power = None if exponent is None else Fraction(int(exponent.p), int(exponent.q))
+        arcs.append(StretchedArc(number(kappa), power, number(coefficient), polynomial, field.digits,
+                                 None if analytic == 0 else (analytic, _ARC_VARIABLE)))
     return tuple(arcs)
+
+
+def _check_analytic_on_arc(law: sympy.Expr, kappa: sympy.Expr, problem: Oscillator) -> None:
+    """The analytic part of an arc's law must be continuous on the arc's range [κ, 1] of Y (closed)."""
+    arc = sympy.Interval(kappa, 1)
+    try:
+        domain = sympy.calculus.util.continuous_domain(law, _ARC_VARIABLE, arc)
+    except (NotImplementedError, TypeError, ValueError):  # undecided: the arc's own finiteness check decides
+        return
+    if domain != arc:
+        raise UnsupportedNonlinearityError(
+            f"f = {problem.f}: its law {law} (in w = u/a0 on the contact arc) is not analytic on the whole arc "
+            f"[{kappa}, 1]; a non-polynomial piece must be analytic up to its breakpoint"
+        )
 
 
 def _assemble(
@@ -333,7 +358,9 @@ def _assemble(
 ) -> PiecewiseNormalForm:
     """The normal form with its coefficient field; ``crossed`` lists the grazing breakpoints
     (κ, interval beyond, σ_1) that the perturbed orbit passes (gauge η = ε̂^{1/2})."""
-    fractional_pieces = [piece for piece, interval_index in enumerate(interval_of) if w_intervals[interval_index][3]]
+    # pieces whose law is not polynomial: a fractional power of the distance to a breakpoint, or an analytic part
+    fractional_pieces = [piece for piece, interval_index in enumerate(interval_of)
+                         if w_intervals[interval_index][3] or w_intervals[interval_index][4] != 0]
     if fractional_pieces and crossed:
         raise UnsupportedNonlinearityError(f"f = {problem.f}: a fractional power law at a grazing breakpoint is not supported")
     top = [item for item in crossed if item[0] > 0]

@@ -7,7 +7,9 @@ the normalised law is
 
     Ω² W'' + W + ε̂ f̂(W) = 0,   f̂(W) = Σ_m c_m W^m + c (W − κ)^p,   W > κ,
 
-with a rational exponent ``p = q/d > 0`` that is not an integer (Hertz: p = 3/2).
+with a rational exponent ``p = q/d > 0`` that is not an integer (Hertz: p = 3/2), plus,
+if the law has one, an analytic part g(W) expanded about Y_0 at every point,
+``[g(Y)]_n = Σ_k g^{(k)}(Y_0)/k! [(Y − Y_0)^k]_n`` (an analytic law alone has d = 1).
 The solution is not analytic at the contact point W = κ (W − κ ~ s* − s, so
 W'' ~ (s* − s)^p), and that point moves with ε̂: Lindstedt coefficients W_n(s) at a
 fixed s would diverge there from the order where p − n < −1.  So the arc is mapped
@@ -47,13 +49,15 @@ log10(1/v_min^d) of them).
 
 from __future__ import annotations
 
+import math
 from fractions import Fraction
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import mpmath
 import numpy as np
+import sympy
 
-from .._errors import ConvergenceError
+from .._errors import ConvergenceError, UnsupportedNonlinearityError
 
 __all__ = ["StretchedArc", "FloatArc"]
 
@@ -92,6 +96,8 @@ class StretchedArc:
         c_0, c_1, … of the polynomial part of the law on the arc.
     digits : int
         Decimal digits wanted.
+    analytic : (sympy expression, symbol), optional
+        An analytic part g(Y) of the law (``exponent`` may then be None: no fractional term).
 
     Examples
     --------
@@ -103,18 +109,21 @@ class StretchedArc:
     True
     """
 
-    def __init__(self, kappa: Any, exponent: Fraction, coefficient: Any, polynomial: Sequence[Any], digits: int):
-        if exponent <= 0 or exponent.denominator == 1:
-            raise ValueError("the stretched arc is for non-integer exponents p > 0")
+    def __init__(self, kappa: Any, exponent: Fraction | None, coefficient: Any, polynomial: Sequence[Any], digits: int,
+                 analytic: tuple[Any, Any] | None = None):
+        if exponent is not None and (exponent <= 0 or exponent.denominator == 1):
+            raise ValueError("the stretched arc's power law needs a non-integer exponent p > 0")
         self.exponent = exponent
-        self.denominator = exponent.denominator
+        self.denominator = 1 if exponent is None else exponent.denominator
+        self._analytic_terms: list[Callable[[Any], Any]] = []
+        self._analytic_expression, self._analytic_symbol = analytic if analytic is not None else (None, None)
         self.digits = digits
         self._working = digits + _GUARD_DIGITS
         self._turning: list[Any] = [mpmath.mpf(1)]  # h_n = Y_n(0) as fixed so far
         self._pending: tuple[int, dict] | None = None
         with mpmath.workdps(self._working):
             self.kappa = mpmath.mpf(kappa)
-            self.coefficient = mpmath.mpf(coefficient)
+            self.coefficient = mpmath.mpf(coefficient) if exponent is not None else mpmath.mpf(0)
             self.polynomial = [mpmath.mpf(value) for value in polynomial]
             self.beta = mpmath.acos(self.kappa)
         self.nodes = _INITIAL_NODES
@@ -135,7 +144,7 @@ class StretchedArc:
             self._sin = [mpmath.sin(beta * t) for t in self._tau]
             # Y_0 − κ = cos βτ − cos β = 2 sin(β(1 + τ)/2) sin(β v^d/2), without cancellation near τ = 1
             self._gap = [2 * mpmath.sin(beta * (1 + t) / 2) * mpmath.sin(beta * vi**d / 2) for t, vi in zip(self._tau, self._v)]
-            self._weight = [self.coefficient * g**self.exponent for g in self._gap]
+            self._weight = [self.coefficient * g**self.exponent for g in self._gap] if self.exponent is not None else [mpmath.mpf(0)] * M
             self._jacobian = [d * vi ** (d - 1) for vi in self._v]  # −dt/dν
             self._transform = [[mpmath.cos(k * angle) for angle in angles] for k in range(M)]
         self._values: list[list[Any]] = [list(self._cos)]  # Y_n at the nodes
@@ -143,6 +152,8 @@ class StretchedArc:
         self._ratios: list[list[Any]] = [[]]  # R_n (n ≥ 1)
         self._binomial: list[list[Any]] = [[mpmath.mpf(1)] * M]  # B_n of (1 + Σ R ε̂)^p
         self._powers: dict[tuple[int, int], list[Any]] = {}
+        self._taylor: dict[int, list[Any]] = {}  # g^{(k)}(Y_0)/k! at the nodes
+        self._deviation: dict[tuple[int, int], list[Any]] = {}  # [(Y − Y_0)^k]_n at the nodes
         self._mu: list[Any] = [1 / (beta * beta)]
         self._slope: list[Any] = [-beta * mpmath.sin(beta)]
         self._series: list[tuple[list[Any], list[Any]]] = []  # Chebyshev coefficients of Y_n and Y_n' (n ≥ 1)
@@ -188,10 +199,45 @@ class StretchedArc:
             self._powers[key] = result
         return self._powers[key]
 
+    def _taylor_values(self, k: int) -> list[Any]:
+        """g^{(k)}(Y_0)/k! at the nodes (the analytic part of the law)."""
+        if k not in self._taylor:
+            while len(self._analytic_terms) <= k:
+                derivative = sympy.diff(self._analytic_expression, self._analytic_symbol, len(self._analytic_terms))
+                scale = sympy.Integer(math.factorial(len(self._analytic_terms)))
+                self._analytic_terms.append(sympy.lambdify(self._analytic_symbol, derivative / scale, modules="mpmath"))
+            values = [mpmath.mpf(self._analytic_terms[k](y)) for y in self._cos]
+            if not all(mpmath.isfinite(value) for value in values):
+                raise UnsupportedNonlinearityError(
+                    f"the law {self._analytic_expression} is not analytic on the contact arc (derivative {k} is not finite there)"
+                )
+            self._taylor[k] = values
+        return self._taylor[k]
+
+    def _deviation_power(self, power: int, order: int) -> list[Any]:
+        """[(Y − Y_0)^power]_order at the nodes (power ≥ 1, order ≥ power)."""
+        key = (power, order)
+        if key not in self._deviation:
+            if power == 1:
+                result = self._values[order]
+            else:
+                result = [mpmath.mpf(0)] * self.nodes
+                for j in range(1, order - power + 2):
+                    left, right = self._values[j], self._deviation_power(power - 1, order - j)
+                    result = [r + x * y for r, x, y in zip(result, left, right)]
+            self._deviation[key] = result
+        return self._deviation[key]
+
     def _law(self, order: int) -> list[Any]:
         """[f̂(Y)]_order at the nodes."""
         M = self.nodes
         total = [self._weight[i] * self._binomial[order][i] for i in range(M)]
+        if self._analytic_expression is not None:
+            if order == 0:
+                total = [t + g for t, g in zip(total, self._taylor_values(0))]
+            for k in range(1, order + 1):
+                term = self._deviation_power(k, order)
+                total = [t + g * x for t, g, x in zip(total, self._taylor_values(k), term)]
         for power, value in enumerate(self.polynomial):
             if not value:
                 continue
@@ -234,7 +280,7 @@ class StretchedArc:
 
     def _solve(self, order: int, release: Any, data: dict) -> None:
         M, beta = self.nodes, self.beta
-        p = mpmath.mpf(self.exponent.numerator) / self.exponent.denominator
+        p = mpmath.mpf(0) if self.exponent is None else mpmath.mpf(self.exponent.numerator) / self.exponent.denominator
         forcing, cos_integral, sin_integral = data["forcing"], data["cos"], data["sin"]
         resonant = beta**3 / 2
         mu_constant, mu_per_h, slope_constant, slope_per_h = self._response(data)
@@ -255,6 +301,7 @@ class StretchedArc:
         # B_n = (1/n) Σ_{k=1}^{n} ((p + 1) k − n) R_k B_{n−k}   (powers of 1 + Σ R_k ε̂^k)
         self._binomial.append(
             [mpmath.fsum(((p + 1) * k - order) * self._ratios[k][i] * self._binomial[order - k][i] for k in range(1, order + 1)) / order for i in range(M)]
+            if self.exponent is not None else [mpmath.mpf(0)] * M
         )
         self._mu.append(mu)
         self._slope.append(end_slope)

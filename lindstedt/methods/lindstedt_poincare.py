@@ -16,7 +16,7 @@ from typing import Any, Callable, Hashable, Mapping, NamedTuple
 from .._errors import OrderError, ProblemError
 from ..results.expansion import Expansion
 from ..problems.oscillator import DISPLACEMENT, Oscillator
-from ..problems.piecewise_linear import has_fractional_power
+from ..problems.piecewise_linear import has_non_polynomial_law
 from ..engine.branches import BranchHierarchy
 from ..engine.contact import contact_normal_form
 from ..engine.smooth import MAX_ORDER, SmoothHierarchy, normal_form
@@ -169,8 +169,8 @@ class LindstedtPoincare:
         """
         problem_key = _problem_key(problem)
         if problem.is_non_smooth:
-            # exact unless asked for floats or the law has a fractional power (Hertz: its arc is numeric)
-            if not (self.numeric or has_fractional_power(problem.nonlinearity, DISPLACEMENT)):
+            # exact unless asked for floats or a piece is not polynomial (Hertz, exp: its contact arc is numeric)
+            if not (self.numeric or has_non_polynomial_law(problem.nonlinearity, DISPLACEMENT)):
                 # Exact: the normal form does not depend on the order; it is built only on a miss
                 # (its domain has fresh Dummy generators and must not enter the key).
                 key, make_form = (problem_key, "piecewise", None), lambda: contact_normal_form(problem, None)

@@ -22,7 +22,7 @@ import sympy
 
 from .._errors import UnsupportedNonlinearityError
 
-__all__ = ["PolynomialInterval", "decompose_piecewise", "decompose_piecewise_linear", "has_fractional_power"]
+__all__ = ["PolynomialInterval", "decompose_piecewise", "decompose_piecewise_linear", "has_non_polynomial_law"]
 
 _SWITCHING = (sympy.Max, sympy.Min, sympy.Abs, sympy.Heaviside, sympy.sign, sympy.Piecewise)
 _SUPPORTED = (
@@ -31,7 +31,8 @@ _SUPPORTED = (
     "Heaviside(u)*u**2, c*Heaviside(u - b), sign(u), "
     "Piecewise((polynomial, u < b), ..., (polynomial, True)), plus polynomial terms, "
     "and fractional powers of the distance to a breakpoint such as the Hertz law c*Max(0, u - b)**(3/2) "
-    "(rational exponent p > 0; non-polynomial analytic pieces are not supported)"
+    "(rational exponent p > 0); analytic non-polynomial laws such as Max(0, u - b)*exp(u) on the contact arc "
+    "that holds a turning point"
 )
 
 
@@ -44,6 +45,8 @@ class PolynomialInterval:
     coefficients: tuple[sympy.Expr, ...]  # increasing degree, at least (c_0, c_1)
     # terms c·|u − b|^p with b = lower or upper, p a positive non-integer rational: (c, b, p)
     fractional: tuple[tuple[sympy.Expr, sympy.Expr, sympy.Rational], ...] = ()
+    # the rest of the law when it is not a polynomial: an analytic expression in u (zero if none)
+    analytic: sympy.Expr = sympy.S.Zero
 
     @property
     def slope(self) -> sympy.Expr:
@@ -65,9 +68,11 @@ def _switching_atoms(expression: sympy.Expr) -> list[sympy.Expr]:
 
 
 def _linear_argument(argument: sympy.Expr, variable: sympy.Symbol, f: sympy.Expr) -> tuple[sympy.Expr, sympy.Expr]:
-    polynomial = sympy.Poly(sympy.expand(argument), variable) if argument.has(variable) else None
-    if polynomial is None:
+    if not argument.has(variable):
         return sympy.Integer(0), argument
+    if not argument.is_polynomial(variable):  # e.g. sin(1/u): infinitely many switching points
+        raise UnsupportedNonlinearityError(f"f = {f}: the switching argument {argument} is not linear in u; {_SUPPORTED}")
+    polynomial = sympy.Poly(sympy.expand(argument), variable)
     if polynomial.degree() > 1 or any(_switching_atoms(c) for c in polynomial.coeffs()):
         raise UnsupportedNonlinearityError(f"f = {f}: the switching argument {argument} is not linear in u; {_SUPPORTED}")
     slope = polynomial.coeff_monomial(variable)
@@ -107,17 +112,20 @@ def _piece_at(atom: sympy.Piecewise, variable: sympy.Symbol, point: sympy.Expr, 
     raise UnsupportedNonlinearityError(f"f = {f}: the Piecewise {atom} is undefined between breakpoints (add a last piece (…, True))")
 
 
-def has_fractional_power(f: sympy.Expr, variable: sympy.Symbol) -> bool:
-    """True when f has a non-integer power of an expression in u (then it is expanded numerically).
+def has_non_polynomial_law(f: sympy.Expr, variable: sympy.Symbol) -> bool:
+    """True when a piece of f is not a polynomial in u: a non-integer power of an expression in u, or a
+    function of u other than the switches (its contact arc is then solved numerically).
 
     Examples
     --------
     >>> import sympy
     >>> u = sympy.Symbol("u", real=True)
-    >>> has_fractional_power(sympy.Max(0, u)**sympy.Rational(3, 2), u), has_fractional_power(sympy.Max(0, u)**2, u)
-    (True, False)
+    >>> [has_non_polynomial_law(f, u) for f in (sympy.Max(0, u)**sympy.Rational(3, 2), sympy.Max(0, u)**2, sympy.Max(0, u)*sympy.exp(u))]
+    [True, False, True]
     """
-    return any(atom.base.has(variable) and not atom.exp.is_Integer for atom in f.atoms(sympy.Pow))
+    powers = any(atom.base.has(variable) and not (atom.exp.is_Integer and atom.exp >= 0) for atom in f.atoms(sympy.Pow))
+    functions = any(not isinstance(atom, _SWITCHING) and atom.has(variable) for atom in f.atoms(sympy.Function))
+    return powers or functions
 
 
 def decompose_piecewise_linear(f: sympy.Expr, variable: sympy.Symbol) -> list[PolynomialInterval]:
@@ -236,11 +244,12 @@ def decompose_piecewise(f: sympy.Expr, variable: sympy.Symbol, max_degree: int |
         upper = unique[index] if index < len(unique) else None
         fractional: list[tuple[sympy.Expr, sympy.Expr, sympy.Rational]] = []
         if max_degree is None and not piece.has(*_SWITCHING):
-            # non-integer powers of u stand as placeholders while the rest is expanded
+            # powers of the distance to an end of the interval stand as placeholders while the rest is expanded
             placeholders = {
                 atom: sympy.Dummy("power")
                 for atom in piece.atoms(sympy.Pow)
                 if atom.base.has(variable) and not (atom.exp.is_Integer and atom.exp >= 0)
+                and _vanishes_at_an_end(atom.base, variable, (lower, upper))
             }
             piece = sympy.expand(piece.xreplace(placeholders))
             for atom, placeholder in placeholders.items():
@@ -250,14 +259,27 @@ def decompose_piecewise(f: sympy.Expr, variable: sympy.Symbol, max_degree: int |
                     raise UnsupportedNonlinearityError(f"f = {f}: the term {coefficient * atom} is not c*Max(0, u - b)**p; {_SUPPORTED}")
                 fractional.append(_fractional_term(coefficient, atom, variable, (lower, upper), point, f))
         piece = sympy.expand(piece)
+        analytic = sympy.S.Zero
+        if max_degree is None and not piece.has(*_SWITCHING) and not piece.is_polynomial(variable):
+            analytic = sympy.Add(*[term for term in sympy.Add.make_args(piece) if not term.is_polynomial(variable)])
+            piece = sympy.expand(piece - analytic)
         if piece.has(*_SWITCHING) or not piece.is_polynomial(variable):
             raise UnsupportedNonlinearityError(f"f = {f} is not piecewise polynomial in u (piece {piece}); {_SUPPORTED}")
         degree = max(sympy.degree(piece, variable), 1)
         if max_degree is not None and degree > max_degree:
             raise UnsupportedNonlinearityError(f"f = {f} is not piecewise linear in u (piece {piece}); {_SUPPORTED}")
         coefficients = tuple(sympy.simplify(piece.coeff(variable, power)) for power in range(degree + 1))
-        intervals.append(PolynomialInterval(lower, upper, coefficients, tuple(fractional)))
+        intervals.append(PolynomialInterval(lower, upper, coefficients, tuple(fractional), analytic))
     return intervals
+
+
+def _vanishes_at_an_end(base: sympy.Expr, variable: sympy.Symbol, ends: tuple) -> bool:
+    """True when ``base`` is linear in u and vanishes at an end of the interval."""
+    polynomial = sympy.Poly(sympy.expand(base), variable) if base.is_polynomial(variable) else None
+    if polynomial is None or polynomial.degree() != 1:
+        return False
+    root = -polynomial.coeff_monomial(1) / polynomial.coeff_monomial(variable)
+    return any(end is not None and sympy.simplify(root - end) == 0 for end in ends)
 
 
 def _fractional_term(coefficient: sympy.Expr, power: sympy.Pow, variable: sympy.Symbol, ends: tuple, inside: sympy.Expr, f: sympy.Expr):
