@@ -5,6 +5,8 @@ Sub-commands
 ``lindstedt expand F --order N [--a0 A] [--omega0 W] [--param NAME=VALUE ...]
 [--normalization initial|harmonic] [--format text|latex|json]``
     Lindstedt–Poincaré expansion of the oscillator with nonlinearity F.
+    ``--u0 U --v0 V`` instead of ``--a0``: the orbit through u(0) = U, u'(0) = V
+    (its turning-point and phase series are printed too).
 ``lindstedt nnm SYSTEM.json --mode J --a0 A [--order 2] [--format text|latex|json]``
     Nonlinear normal mode of M X'' + K X + ε W (A X − b)_+ = 0 grown from mode J.
 ``lindstedt nnm SYSTEM.json --mode J --numeric (--a0 A | --energy E) --eps EPS [--format json]``
@@ -82,6 +84,9 @@ def build_parser() -> argparse.ArgumentParser:
     expand.add_argument("--normalization", choices=("initial", "harmonic"), default="initial",
                         help="initial: a0 is u(0); harmonic: a0 is the first-harmonic amplitude")
     expand.add_argument("--a1", default="0", help="release at u(0) = a0 + eps*a1 (default 0; e.g. just inside a gap that a0 touches)")
+    expand.add_argument("--u0", default=None, help="initial displacement u(0) (with --v0; instead of --a0)")
+    expand.add_argument("--v0", default=None,
+                        help="initial velocity u'(0): the orbit through (u0, v0), with its turning-point and phase series")
     expand.add_argument("--format", choices=("text", "latex", "json"), default="text")
     expand.add_argument("--waveforms", action="store_true", help="include the waveforms v_k in text/LaTeX output")
     expand.add_argument("--precision", type=int, default=30, help="decimal digits for non-polynomial f (default 30)")
@@ -125,6 +130,8 @@ def _command_expand(arguments: argparse.Namespace) -> str:
         normalization=arguments.normalization,
         precision=arguments.precision,
         a1=arguments.a1,
+        u0=arguments.u0,
+        v0=arguments.v0,
     )
     if arguments.format == "json":
         return expansion.to_json()

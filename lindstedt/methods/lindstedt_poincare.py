@@ -123,7 +123,19 @@ def _problem_key(problem: Oscillator) -> tuple:
     Parameters are sorted by name (their declaration order does not change the problem).
     """
     params = tuple(sorted(problem.params, key=lambda item: item[0].name))
-    return (problem.f, problem.a0, problem.omega0, params, problem.normalization, problem.a1)
+    key = (problem.f, problem.a0, problem.omega0, params, problem.normalization, problem.a1)
+    if problem.has_initial_velocity:  # the turning-point series handed to the engine: its data and its length
+        key += (problem.u0, problem.v0, problem.release_order, getattr(problem, "_release_digits", None))
+    return key
+
+
+def _release_order_for(order: int) -> int:
+    """ε-orders of the turning-point series an order-``order`` expansion from (u0, v0) hands to its engine: N + 1.
+
+    The evaluators ask for ω through ω_{N+2} (one more power of the gauge ε^{1/2} at grazing), whose
+    waveforms need A_1 … A_{N+1}; :class:`~lindstedt.Expansion` refuses indices beyond what the series covers.
+    """
+    return order + 1
 
 
 class LindstedtPoincare:
@@ -157,6 +169,12 @@ class LindstedtPoincare:
         self.precision = precision
         self.numeric = bool(numeric)
 
+    def _released(self, problem: Oscillator, order: int) -> Oscillator:
+        """The problem from (u0, v0) with its turning-point series long enough for ``order`` (numeric hierarchies of
+        non-polynomial analytic f get it rounded to the working digits plus 20)."""
+        analytic = not problem.is_polynomial and not problem.is_non_smooth
+        return problem.with_release_order(_release_order_for(order), self.precision + 20 if analytic else None)
+
     def hierarchy(self, problem: Oscillator, order: int = 4) -> tuple[Any, Any]:
         """The normal form of ``problem`` and its (cached) hierarchy: smooth, or the branch hierarchy.
 
@@ -165,8 +183,14 @@ class LindstedtPoincare:
 
         The cache key is the problem's exact data (:func:`_problem_key`) and what
         of the method's settings the hierarchy depends on: the working digits of
-        a float hierarchy, ``precision`` for non-polynomial smooth f.
+        a float hierarchy, ``precision`` for non-polynomial smooth f.  A problem
+        from initial data (u0, v0) is expanded from its positive turning point,
+        with the release series A_1 … A_{order+1} (:meth:`Oscillator.with_release_order`);
+        u0, v0 and that length are part of the key.
         """
+        if problem.has_initial_velocity:
+            # (u0, v0): the release series A_1 … A_M must cover every order the hierarchy will be asked for
+            problem = self._released(problem, order)
         problem_key = _problem_key(problem)
         if problem.is_non_smooth:
             # exact unless asked for floats or a piece is not polynomial (Hertz, exp: its contact arc is numeric)
@@ -203,6 +227,8 @@ class LindstedtPoincare:
         """
         validate_order(order)
         form, hierarchy = self.hierarchy(problem, order)
+        if problem.has_initial_velocity:  # the copy (== problem) that knows how far its release series goes
+            problem = self._released(problem, order)
         return Expansion(problem=problem, order=order, _hierarchy=hierarchy, _form=form)
 
 
@@ -230,8 +256,11 @@ def expand(
     precision: int = 30,
     numeric: bool = False,
     a1: Any = 0,
+    u0: Any = None,
+    v0: Any = None,
 ) -> Expansion:
-    """Lindstedt–Poincaré expansion of ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0``, ``u'(0) = 0``.
+    """Lindstedt–Poincaré expansion of ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0``, ``u'(0) = 0``
+    (or ``u(0) = u0``, ``u'(0) = v0``).
 
     Parameters
     ----------
@@ -253,6 +282,12 @@ def expand(
         (much faster at high order; exact inputs otherwise give exact results).
     a1 : number, str or sympy expression
         Release at u(0) = a0 + ε a1 (default 0), e.g. just inside a gap that a0 touches.
+    u0, v0 : number or numeric string, optional
+        General initial data u(0) = u0, u'(0) = v0 instead of ``a0``/``a1`` (a missing one is 0;
+        ``"initial"`` normalization).  The expansion is released at the positive turning point
+        A(ε) = Σ A_k ε^k of that orbit (``Expansion.amplitude``) and ``u(t) = v(ω t + φ(ε))``
+        with the phase series ``Expansion.phase``; ``v0 = 0`` is exactly the release at rest
+        ``a0 = u0``.
 
     Returns
     -------
@@ -263,13 +298,19 @@ def expand(
     >>> import lindstedt
     >>> lindstedt.expand("u**3", order=2, normalization="harmonic").omega
     (omega0, 3*a0**2/(8*omega0), -15*a0**4/(256*omega0**3))
+    >>> moving = lindstedt.expand("u**3", order=1, u0="3/5", v0="4/5", omega0=1)
+    >>> moving.amplitude, moving.omega                      # the orbit turns at A = 1 - 136/625 eps + ...
+    ((1, -136/625), (1, 3/8))
+    >>> round(float(moving.displacement(0.0, 0.01)), 4), round(float(moving.velocity(0.0, 0.01)), 4)   # O(eps^2)
+    (0.6, 0.8)
     """
     validate_order(order)
     if isinstance(f, Oscillator):
-        if a0 is not None or omega0 is not None or params is not None or normalization != "initial" or a1 != 0:
+        if (a0 is not None or omega0 is not None or params is not None or normalization != "initial" or a1 != 0
+                or u0 is not None or v0 is not None):
             raise TypeError("pass either an Oscillator or f with its problem arguments, not both")
         problem = f
     else:
-        problem = Oscillator(f, a0=a0, omega0=omega0, params=params, normalization=normalization, a1=a1)
+        problem = Oscillator(f, a0=a0, omega0=omega0, params=params, normalization=normalization, a1=a1, u0=u0, v0=v0)
     # The hierarchy is taken from the process-wide cache (see lindstedt.clear_cache).
     return LindstedtPoincare(precision=precision, numeric=numeric).expand(problem, order)

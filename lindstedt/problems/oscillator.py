@@ -1,4 +1,5 @@
-"""The one-degree-of-freedom problem  u'' + ω0² u + ε f(u) = 0,  u(0) = a0 + ε a1,  u'(0) = 0.
+"""The one-degree-of-freedom problem  u'' + ω0² u + ε f(u) = 0,  u(0) = a0 + ε a1,  u'(0) = 0
+(or general initial data u(0) = u0, u'(0) = v0).
 
 ``Oscillator`` is a frozen dataclass that parses, sympifies and validates its
 inputs when it is built, so that every method downstream receives a problem
@@ -12,20 +13,45 @@ normalisation is explicit:
 ``"harmonic"``
     ``a0`` is the amplitude of the first harmonic: the ``cos(s)`` coefficient of
     every correction v_k, k ≥ 1, vanishes.
+
+**General initial data** ``u(0) = u0``, ``u'(0) = v0`` (``Oscillator(f, u0=..., v0=...)``,
+exclusive with ``a0``/``a1``; ``"initial"`` normalization only).  The motion conserves
+``E = u'²/2 + V(u)``, ``V(u) = ω0² u²/2 + ε F(u)``, ``F' = f``, ``F(0) = 0``, so the orbit
+through (u0, v0) turns at the **positive** turning point ``A(ε) > 0`` with ``V(A) = E``:
+
+    A² + (2ε/ω0²) F(A) = u0² + v0²/ω0² + (2ε/ω0²) F(u0).
+
+With ``A = A0 + δ``, ``A0 = (u0² + v0²/ω0²)^{1/2}``, ``δ = Σ_{n≥1} ε^n A_n`` and
+``F(A0 + δ) = F(A0) + Σ_{m≥1} c_m δ^m``, ``c_m = f^{(m−1)}(A0)/m!`` (on the piece of f
+that contains A0), the ε^n coefficient gives, exactly,
+
+    A_n = −[ Σ_{i=1}^{n−1} A_i A_{n−i} + (2/ω0²) ( [n = 1] (F(A0) − F(u0)) + Σ_{m≥1} c_m [δ^m]_{n−1} ) ] / (2 A0).
+
+If A0 sits on a breakpoint of f, the side is the sign of the first nonzero A_k (the
+one-sided coefficients c_m enter only after it); if every A_k vanishes the orbit only
+touches the breakpoint.  The problem is then the release at rest at ``a0 = A0`` with
+``release_shifts = (A_1, A_2, …)`` (:meth:`Oscillator.amplitude_series`), and the motion
+is ``u(t) = v(ω t + φ(ε); ε)`` with the phase φ of :class:`~lindstedt.Expansion`.
+``v0 = 0`` is the release at rest at ``a0 = u0``: that problem is built, identical to
+``Oscillator(f, a0=u0)`` (``u0`` and ``v0`` are then stored as ``None``).
 """
 
 from __future__ import annotations
 
+import copy
 import keyword
+import math
+import threading
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 import sympy
 
-from .._errors import ParameterError, ProblemError
+from .._errors import ParameterError, ProblemError, UnsupportedNonlinearityError
 from .parsing import ALLOWED_FUNCTIONS, CONSTANTS, as_exact, parse_expression, parse_real, parse_value
+from .piecewise_linear import decompose_piecewise
 
-__all__ = ["Oscillator", "NORMALIZATIONS", "DISPLACEMENT"]
+__all__ = ["Oscillator", "NORMALIZATIONS", "DISPLACEMENT", "DEFAULT_RELEASE_ORDER"]
 
 NORMALIZATIONS = ("initial", "harmonic")
 DISPLACEMENT = sympy.Symbol("u", real=True)
@@ -33,6 +59,10 @@ _NON_SMOOTH = (sympy.Max, sympy.Min, sympy.Heaviside, sympy.Abs, sympy.sign, sym
 # Names a parameter cannot take: the variables of the problem and of its results (u, the strained time s,
 # the time t, epsilon, a0, omega0, the normalised w) and the names the parser reserves for functions and constants.
 RESERVED_NAMES = frozenset({"u", "s", "t", "w", "epsilon", "a0", "omega0"}) | frozenset(ALLOWED_FUNCTIONS) | frozenset(CONSTANTS)
+#: How many ε-orders of the turning-point series A_1, A_2, … an Oscillator built from (u0, v0) hands to
+#: an engine by default (``release_shifts``); :class:`~lindstedt.LindstedtPoincare` extends it to the
+#: order it expands to (:meth:`Oscillator.with_release_order`).
+DEFAULT_RELEASE_ORDER = 4
 
 
 def _default_amplitude() -> sympy.Symbol:
@@ -53,6 +83,206 @@ def _given_quantity(value: Any, what: str) -> sympy.Expr:
             raise ProblemError(f"{what} = {value}: declare its symbols real, e.g. sympy.Symbol('{what}', positive=True)")
         return expression
     return parse_real(value, what=what)
+
+
+def _decided_sign(value: sympy.Expr, what: str) -> int:
+    """Sign (-1, 0, 1) of an exact real expression; a ProblemError naming ``what`` when it cannot be decided."""
+    if value.is_zero:
+        return 0
+    if value.is_positive:
+        return 1
+    if value.is_negative:
+        return -1
+    if value.free_symbols:
+        names = ", ".join(sorted(str(symbol) for symbol in value.free_symbols))
+        raise ProblemError(
+            f"the initial data need the sign of {value} ({what}), which depends on {names}; give numbers for them "
+            "(omega0=..., params={...})"
+        )
+    approximation = sympy.N(value, 60)
+    if approximation != 0 and abs(approximation) > sympy.Float("1e-45"):
+        return 1 if approximation > 0 else -1
+    if sympy.simplify(value) == 0:
+        return 0
+    approximation = sympy.N(value, 400)
+    if approximation == 0:  # pragma: no cover - an exact zero sympy could not prove
+        return 0
+    return 1 if approximation > 0 else -1
+
+
+def reduce_quadratic(value: sympy.Expr, generator: sympy.Symbol, square: sympy.Expr) -> sympy.Expr:
+    """``value`` in the field K(a), a = ``generator`` with a² = ``square``: the canonical form P + Q a
+    (P, Q cancelled rational functions of the other symbols, a rational denominator).
+
+    Examples
+    --------
+    >>> a = sympy.Symbol("a", positive=True)
+    >>> reduce_quadratic(1 / (1 + a), a, 2)      # 1/(1 + √2) = √2 − 1
+    a - 1
+    """
+    a = generator
+    if not value.has(a):
+        return sympy.cancel(value)
+    modulus = sympy.Poly(a**2 - square, a)
+    numerator, denominator = sympy.fraction(sympy.cancel(sympy.together(value)))
+    numerator = sympy.Poly(numerator, a).rem(modulus)
+    denominator = sympy.Poly(denominator, a).rem(modulus)
+    r, s = denominator.coeff_monomial(1), denominator.coeff_monomial(a)
+    if s != 0:  # rationalise: (p + q a)/(r + s a) = (p + q a)(r − s a)/(r² − s² a²)
+        numerator = (numerator * sympy.Poly(r - s * a, a)).rem(modulus)
+        denominator_value = sympy.expand(r**2 - s**2 * square)
+    else:
+        denominator_value = r
+    p, q = numerator.coeff_monomial(1), numerator.coeff_monomial(a)
+    return sympy.cancel(p / denominator_value) + sympy.cancel(q / denominator_value) * a
+
+
+class _TurningPoint:
+    """The positive turning point A(ε) = Σ ε^n A_n of the orbit through (u0, v0), exactly and lazily.
+
+    Reversion of the energy equation A² + (2ε/ω0²) F(A) = u0² + v0²/ω0² + (2ε/ω0²) F(u0)
+    (see the module docstring); thread safe (one lock per problem), shared by the copies
+    of :meth:`Oscillator.with_release_order`.
+
+    For polynomial and piecewise-polynomial f with an irrational A0 = R^{1/2} the arithmetic runs in
+    the field K(A0) = K[a]/(a² − R): every A_n is kept as P + Q a with P, Q rational functions of the
+    other symbols (ω0, parameters), so no nested radicals build up; ``a`` is replaced by A0 on output.
+    """
+
+    def __init__(self, problem: "Oscillator"):
+        self._f = problem.nonlinearity
+        self._omega0 = problem.omega0
+        self._start = problem.u0
+        self._amplitude = problem.a0
+        self._non_smooth = problem.is_non_smooth
+        self._radicand = sympy.expand(problem.u0**2 + problem.v0**2 / problem.omega0**2)  # A0²
+        # the generator a of K(A0) (None: work with A0 itself — rational A0, or non-polynomial analytic f)
+        algebraic = problem.is_polynomial or problem.is_non_smooth
+        self._a = sympy.Dummy("A0", positive=True) if algebraic and not problem.a0.is_Rational else None
+        self._internal: list[sympy.Expr] = [self._a if self._a is not None else problem.a0]
+        self._series: list[sympy.Expr] = [problem.a0]
+        self._lock = threading.Lock()
+        self._prepared = False
+        self._difference: sympy.Expr = sympy.Integer(0)  # F(A0) − F(u0)
+        self._laws: dict[int, sympy.Expr] = {}  # side (+1 above, −1 below, 0 inside a piece) -> f on that piece
+        self._side: int | None = None  # the side of A0 the turning point is on (breakpoint only)
+        self._derivatives: dict[tuple[int, int], sympy.Expr] = {}
+
+    def __getstate__(self) -> dict[str, Any]:  # picklable (and deep-copyable): the lock is not state
+        state = self.__dict__.copy()
+        del state["_lock"]
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._lock = threading.Lock()
+
+    def series(self, order: int) -> tuple[sympy.Expr, ...]:
+        with self._lock:
+            if not self._prepared:
+                self._prepare()
+            while len(self._series) <= order:
+                value = self._next()
+                self._internal.append(value)
+                self._series.append(self._output(value))
+            return tuple(self._series[: order + 1])
+
+    # -- arithmetic in K(A0) -------------------------------------------------------------------------
+    def _output(self, value: sympy.Expr) -> sympy.Expr:
+        if self._a is None:
+            return value
+        return value.xreplace({self._a: self._amplitude})
+
+    def _reduce(self, value: sympy.Expr) -> sympy.Expr:
+        """``value`` in canonical form: P + Q a (a² = A0²) with a rational denominator, or cancelled."""
+        if self._a is None:
+            return sympy.cancel(sympy.expand(value)) if value.free_symbols else sympy.expand(value)
+        try:
+            return reduce_quadratic(value, self._a, self._radicand)
+        except sympy.PolynomialError:  # a fractional power (u − b)^p at A0: not polynomial in a, keep it as it is
+            return sympy.expand(value)
+
+    # -- the potential near A0 -----------------------------------------------------------------
+    def _prepare(self) -> None:
+        u, amplitude, start = DISPLACEMENT, self._amplitude, self._start
+        top = self._internal[0]  # A0, or its generator a
+        if not self._non_smooth:
+            self._difference = self._reduce(sympy.integrate(self._f, (u, start, top)))
+            self._laws = {0: self._f}
+            self._prepared = True
+            return
+        try:
+            intervals = decompose_piecewise(self._f, u)
+        except UnsupportedNonlinearityError as error:
+            raise UnsupportedNonlinearityError(f"the energy of the initial data needs f piecewise polynomial: {error}") from None
+        total = sympy.Integer(0)
+        for interval in intervals:
+            law = sum((c * u**m for m, c in enumerate(interval.coefficients)), sympy.Integer(0))
+            for coefficient, point, power in getattr(interval, "fractional", ()):  # c·|u − b|^p, b an end of the piece
+                law += coefficient * ((u - point) if point == interval.lower else (point - u)) ** power
+            lower, upper = start, top  # u0 < A0: the integral runs over [u0, A0] ∩ [lower, upper]
+            if interval.lower is not None and _decided_sign(interval.lower - start, "a breakpoint against u0") > 0:
+                lower = interval.lower
+            if interval.upper is not None and _decided_sign(interval.upper - amplitude, "a breakpoint against A0") < 0:
+                upper = interval.upper
+            length = upper.xreplace({top: amplitude}) - lower.xreplace({top: amplitude})
+            if _decided_sign(length, "the pieces of f between u0 and A0") > 0:
+                total += sympy.integrate(law, (u, lower, upper))
+            below = interval.lower is None or _decided_sign(amplitude - interval.lower, "A0 against a breakpoint") >= 0
+            above = interval.upper is None or _decided_sign(interval.upper - amplitude, "A0 against a breakpoint") >= 0
+            if below and above:
+                at_lower = interval.lower is not None and _decided_sign(amplitude - interval.lower, "") == 0
+                at_upper = interval.upper is not None and _decided_sign(interval.upper - amplitude, "") == 0
+                self._laws[1 if at_lower else -1 if at_upper else 0] = law
+        self._difference = self._reduce(total)
+        self._prepared = True
+
+    def _coefficient(self, power: int) -> sympy.Expr:
+        """c_m = f^{(m−1)}(A0)/m! on the piece of the turning point."""
+        side = 0 if 0 in self._laws else self._side
+        key = (side, power)
+        if key not in self._derivatives:
+            if side is None:  # pragma: no cover - only asked for after a nonzero A_k decided the side
+                raise ProblemError("the side of the breakpoint at A0 is undecided")
+            derivative = sympy.diff(self._laws[side], DISPLACEMENT, power - 1)
+            value = derivative.subs(DISPLACEMENT, self._internal[0]) / math.factorial(power)
+            if value.has(sympy.zoo, sympy.oo, -sympy.oo, sympy.nan):
+                raise UnsupportedNonlinearityError(
+                    f"the turning point A0 = {self._amplitude} of the orbit through (u0, v0) sits where a fractional power "
+                    "of f vanishes: A(eps) is not a power series there; move u0 or v0 off that orbit"
+                )
+            self._derivatives[key] = self._reduce(value)
+        return self._derivatives[key]
+
+    # -- the reversion -----------------------------------------------------------------------------
+    def _power(self, power: int, order: int) -> sympy.Expr:
+        """The ε^order coefficient of δ^power, δ = Σ_{k≥1} A_k ε^k (known A_k only)."""
+        series = self._internal
+        table = [sympy.Integer(1)] + [sympy.Integer(0)] * order  # δ^0
+        for _ in range(power):
+            table = [
+                self._reduce(sympy.Add(*[series[k] * table[j - k] for k in range(1, j + 1) if table[j - k] != 0]))
+                for j in range(order + 1)
+            ]
+        return table[order]
+
+    def _next(self) -> sympy.Expr:
+        series, n = self._internal, len(self._internal)
+        square = sympy.Add(*[series[i] * series[n - i] for i in range(1, n)])
+        force = self._difference if n == 1 else sympy.Integer(0)
+        moved = [k for k in range(1, n) if self._series[k] != 0]
+        if moved:
+            if self._side is None and 0 not in self._laws:
+                self._side = _decided_sign(self._series[moved[0]], "the side of the breakpoint the turning point moves to")
+            for power in range(1, n):
+                coefficient = self._coefficient(power)
+                if coefficient != 0:
+                    force += coefficient * self._power(power, n - 1)
+        value = self._reduce(-(square + 2 * force / self._omega0**2) / (2 * series[0]))
+        if not value.free_symbols - ({self._a} if self._a is not None else set()) and value != 0:
+            if _decided_sign(self._output(value), "A_n") == 0:
+                value = sympy.Integer(0)
+        return value
 
 
 @dataclass(frozen=True)
@@ -82,6 +312,13 @@ class Oscillator:
         The O(ε) shift of the release point, u(0) = a0 + ε a1 (default 0; "initial" normalization
         only).  It matters where a0 sits exactly on a breakpoint: the release just inside or
         outside a gap (seed Prop. 2.3).
+    u0, v0 : number or numeric string, optional
+        General initial data u(0) = u0, u'(0) = v0 (exact finite real numbers; a missing one
+        is 0).  Exclusive with ``a0`` and ``a1``; needs ``normalization="initial"``.  With
+        ``v0 = 0`` the problem *is* the release at rest ``a0 = u0`` (``u0``, ``v0`` are stored
+        as ``None``); otherwise ``a0`` becomes the positive turning point
+        ``A0 = (u0² + v0²/ω0²)^{1/2}`` and :attr:`release_shifts` its corrections
+        A_1, A_2, … from the energy (see the module docstring).
 
     Raises
     ------
@@ -95,6 +332,11 @@ class Oscillator:
     u**5/3 + u**3
     >>> problem.normalization
     'initial'
+    >>> moving = Oscillator("u**3", u0="3/5", v0="4/5", omega0=1)   # through u(0) = 3/5, u'(0) = 4/5
+    >>> moving.a0, moving.amplitude_series(2)                        # its positive turning point A(eps)
+    (1, (1, -136/625, 75752/390625))
+    >>> Oscillator("u**3", u0=1, v0=0) == Oscillator("u**3", a0=1)
+    True
     """
 
     f: Any
@@ -103,6 +345,8 @@ class Oscillator:
     params: Any = None
     normalization: str = "initial"
     a1: Any = 0
+    u0: Any = None
+    v0: Any = None
     variable: sympy.Symbol = field(default=DISPLACEMENT, init=False)
 
     def __post_init__(self) -> None:
@@ -151,8 +395,13 @@ class Oscillator:
         if expression.has(sympy.zoo, sympy.oo, sympy.nan, -sympy.oo):
             raise ProblemError(f"f = {expression} contains an infinity or NaN")
 
-        amplitude = self._parse_amplitude(self.a0)
         omega0 = self._parse_omega0(self.omega0)
+        initial_data = self._parse_initial_data(omega0)
+        if initial_data is None:
+            amplitude = self._parse_amplitude(self.a0)
+            start, speed = None, None
+        else:
+            amplitude, start, speed = initial_data
         release_shift = _given_quantity(self.a1, "a1")
         if release_shift != 0 and self.normalization != "initial":
             raise ProblemError("a1 shifts the release point u(0) = a0 + eps*a1: it needs normalization='initial'")
@@ -168,7 +417,42 @@ class Oscillator:
         set_field(self, "a0", amplitude)
         set_field(self, "omega0", omega0)
         set_field(self, "a1", release_shift)
+        set_field(self, "u0", start)
+        set_field(self, "v0", speed)
         set_field(self, "params", tuple((parameter_symbols[name], values[name]) for name in raw_params))
+        set_field(self, "_release_order", DEFAULT_RELEASE_ORDER if speed is not None else None)
+        set_field(self, "_release_digits", None)
+        set_field(self, "_turning", _TurningPoint(self) if speed is not None else None)
+
+    def _parse_initial_data(self, omega0: sympy.Expr) -> tuple[sympy.Expr, sympy.Expr | None, sympy.Expr | None] | None:
+        """(a0, u0, v0) from u0/v0 (None when neither is given); v0 = 0 is the release at rest a0 = u0."""
+        if self.u0 is None and self.v0 is None:
+            return None
+        if self.normalization != "initial":
+            raise ProblemError(
+                "u0/v0 prescribe u(0) and u'(0), which needs normalization='initial' (the 'harmonic' normalization "
+                "prescribes the first-harmonic amplitude a0 instead); drop normalization='harmonic', or give a0= without u0/v0"
+            )
+        if self.a0 is not None:
+            raise ProblemError(
+                "give either a0 (release at rest, u(0) = a0 + eps*a1, u'(0) = 0) or u0/v0 (u(0) = u0, u'(0) = v0), not both; "
+                "the release at rest at a0 is u0=a0 with v0=0"
+            )
+        if _given_quantity(self.a1, "a1") != 0:
+            raise ProblemError(
+                "a1 shifts a release at rest (u(0) = a0 + eps*a1); with u0/v0 the initial data are exact: remove a1 "
+                "(or put the shift into u0)"
+            )
+        start = sympy.Integer(0) if self.u0 is None else parse_real(self.u0, what="u0")
+        speed = sympy.Integer(0) if self.v0 is None else parse_real(self.v0, what="v0")
+        if start == 0 and speed == 0:
+            raise ProblemError("u0 = v0 = 0 is the rest state, which does not move: give a nonzero u0 or v0")
+        if speed == 0:
+            return start, None, None  # the release at rest at a0 = u0: the same problem as Oscillator(f, a0=u0)
+        amplitude = sympy.sqrt(start**2 * omega0**2 + speed**2) / omega0
+        if amplitude.is_positive is not True:  # pragma: no cover - omega0 > 0 and v0 != 0
+            raise ProblemError(f"the turning point A0 = {amplitude} is not known to be positive; give omega0 as a number")
+        return amplitude, start, speed
 
     # -- parsing of the amplitude and of the linear frequency -------------------------------
     @staticmethod
@@ -213,8 +497,81 @@ class Oscillator:
 
     @property
     def release_shifts(self) -> tuple[sympy.Expr, ...]:
-        """``(a1, a2, …)`` of the release point ``u(0) = a0 + Σ ε^n a_n`` (empty: released at a0 exactly)."""
-        return (self.a1,) if self.a1 != 0 else ()
+        """``(a1, a2, …)`` of the release point ``u(0) = a0 + Σ ε^n a_n`` (empty: released at a0 exactly).
+
+        For general initial data (u0, v0 with v0 ≠ 0) these are the corrections A_1 … A_M of the
+        positive turning point, M = :attr:`release_order` (every normal form reads them as
+        W_n(0) = w_n).  For non-polynomial analytic f, whose hierarchy is numeric, each A_n is
+        handed as ``A0·r_n`` with r_n a rational approximation of A_n/A0 to the digits of
+        :meth:`with_release_order` (the exact A_n: :meth:`amplitude_series`).
+        """
+        if self._turning is None:
+            return (self.a1,) if self.a1 != 0 else ()
+        series = self.amplitude_series(self._release_order)[1:]
+        if self._release_digits is None or self.is_polynomial or self.is_non_smooth:
+            return series
+        digits = self._release_digits
+        return tuple(self.a0 * sympy.Rational(str(sympy.N(shift / self.a0, digits))) for shift in series)
+
+    @property
+    def release_order(self) -> int | None:
+        """How many ε-orders of the turning-point series :attr:`release_shifts` holds (None: a release at rest)."""
+        return self._release_order
+
+    @property
+    def has_initial_velocity(self) -> bool:
+        """True for general initial data with u'(0) = v0 ≠ 0 (then u0, v0 are set)."""
+        return self.v0 is not None
+
+    def with_release_order(self, order: int, digits: int | None = None) -> "Oscillator":
+        """The same problem (``==``) whose :attr:`release_shifts` hold A_1 … A_order (and, for
+        non-polynomial analytic f, are rounded to ``digits`` digits); ``self`` for a release at rest.
+
+        The turning-point series is shared with ``self`` (computed once, lazily).
+
+        Examples
+        --------
+        >>> problem = Oscillator("u**3", u0=0, v0=1, omega0=1)
+        >>> len(problem.release_shifts), len(problem.with_release_order(6).release_shifts)
+        (4, 6)
+        """
+        if self._turning is None:
+            return self
+        if isinstance(order, bool) or not isinstance(order, int) or order < 1:
+            raise ProblemError(f"the release order must be a positive integer, got {order!r}")
+        extended = copy.copy(self)
+        object.__setattr__(extended, "_release_order", order)
+        object.__setattr__(extended, "_release_digits", digits)
+        return extended
+
+    def amplitude_series(self, order: int) -> tuple[sympy.Expr, ...]:
+        """``(A_0, …, A_order)``, exact: the turning point u(0) of the release the expansion starts from.
+
+        General initial data: the positive turning point of the orbit through (u0, v0), by
+        reversion of the energy equation (module docstring).  A release at rest
+        (``"initial"``): ``(a0, a1, 0, …)``.
+
+        Raises
+        ------
+        ProblemError
+            For ``normalization="harmonic"`` (u(0) is then a result of the expansion:
+            ``Expansion.amplitude``), or where a side of a breakpoint cannot be decided.
+
+        Examples
+        --------
+        >>> Oscillator("Max(0, u - 1/4)", u0="3/5", v0="4/5", omega0=1).amplitude_series(2)
+        (1, -11/50, 88/625)
+        """
+        if isinstance(order, bool) or not isinstance(order, int) or order < 0:
+            raise ProblemError(f"order must be a non-negative integer, got {order!r}")
+        if self._turning is not None:
+            return self._turning.series(order)
+        if self.normalization != "initial":
+            raise ProblemError(
+                "with normalization='harmonic' a0 is the first-harmonic amplitude and the turning point is a result: "
+                "use Expansion.amplitude"
+            )
+        return (self.a0, self.a1, *([sympy.Integer(0)] * (order - 1)))[: order + 1]
 
     @property
     def free_symbols(self) -> set[sympy.Symbol]:
@@ -271,8 +628,14 @@ class Oscillator:
         squared = self.omega0**2
         stiffness = f"({sympy.sstr(squared)})" if isinstance(squared, sympy.Add) else sympy.sstr(squared)
         stiffness_term = "u" if squared == 1 else f"{stiffness}*u"
-        release = f"{self.a0}" if self.a1 == 0 else f"{self.a0} + eps*({self.a1})"
-        text = f"u'' + {stiffness_term} + eps*({self.f}) = 0, u(0) = {release} [{self.normalization}]"
+        if self.has_initial_velocity:
+            text = (
+                f"u'' + {stiffness_term} + eps*({self.f}) = 0, u(0) = {self.u0}, u'(0) = {self.v0} "
+                f"[turning point a0 = {self.a0} + O(eps)]"
+            )
+        else:
+            release = f"{self.a0}" if self.a1 == 0 else f"{self.a0} + eps*({self.a1})"
+            text = f"u'' + {stiffness_term} + eps*({self.f}) = 0, u(0) = {release} [{self.normalization}]"
         if params:
             text += f"; {params}"
         if symbolic:

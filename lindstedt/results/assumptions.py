@@ -5,7 +5,8 @@ derivation's assumptions hold: the declared signs of its free symbols (a0 and
 ω0 default to positive), ω0 > 0, a0 ≠ 0, and for piecewise-linear f the side of
 the release point and, for every breakpoint u_i = κ_i a0, where it lies relative
 to the orbit [−|a0|, |a0|] (crossed, grazing, never reached, permanent contact)
-and the order of the breakpoints.  :class:`DerivationAssumptions` lists them and
+and the order of the breakpoints.  A problem from initial data (u0, v0) has numeric
+u0, v0 and a0 = their turning point: the re-derivation it suggests passes u0 and v0.  :class:`DerivationAssumptions` lists them and
 :meth:`~DerivationAssumptions.check` raises a :class:`~lindstedt.ParameterError`
 naming the regime and the re-derivation when numeric values leave them.
 """
@@ -240,7 +241,11 @@ class DerivationAssumptions:
         if not admissible or not all(assumption.rederivable for assumption in violated):
             return message + "no expansion exists there: give omega0 > 0 (the linear angular frequency) and a0 != 0"
         arguments = [repr(sympy.sstr(problem.f)), f"order={self.order}"]
-        arguments.append(f"a0={_literal(problem.a0.xreplace(substitution))}")
+        if problem.has_initial_velocity:  # from (u0, v0): a0 is their turning point, not an input
+            arguments.append(f"u0={_literal(problem.u0)}")
+            arguments.append(f"v0={_literal(problem.v0)}")
+        else:
+            arguments.append(f"a0={_literal(problem.a0.xreplace(substitution))}")
         arguments.append(f"omega0={_literal(problem.omega0.xreplace(substitution))}")
         if problem.params:
             params = ", ".join(f"{str(symbol)!r}: {_literal(value.xreplace(substitution))}" for symbol, value in problem.params)

@@ -12,6 +12,11 @@ v_0 … v_N with the frequency through ω_{N+1} (computed on demand, it needs on
 the secular part of the next forcing): that is the consistent truncation whose
 error is O(ε^{N+1}) uniformly for t ≤ C/ε.
 
+General initial data u(0) = u0, u'(0) = v0 (``lindstedt.expand(f, u0=..., v0=...)``): the expansion
+is released at rest at the orbit's positive turning point ``A(ε) = Σ A_k ε^k`` (:attr:`Expansion.amplitude`)
+and ``u(t) = Σ_k ε^k v_k(ω t + φ(ε))`` with the exact phase series ``φ(ε) = Σ φ_k ε^k``
+(:attr:`Expansion.phase`); the evaluators, :meth:`Expansion.displacement_expr` and generated code include it.
+
 JSON schema ``lindstedt.expansion/1`` (:meth:`Expansion.to_dict`)::
 
     {
@@ -28,6 +33,9 @@ JSON schema ``lindstedt.expansion/1`` (:meth:`Expansion.to_dict`)::
       "waveforms": [{"order": k, "cosine_coefficients": {"n": str}}]   # optional; piecewise f:
                    [{"order": k, "breakpoints": [str], "pieces": [str], "interval": str}]
       "regime", "validity_exponent", "contact_angles"                   # piecewise f only
+      # from u0, v0 only: "problem" also has "u0", "v0"; and
+      "solution": str, "amplitude": [str], "amplitude_float": [float | null],   # A_k
+      "phase": [str], "phase_float": [float | null]                            # φ_k
     }
 """
 
@@ -45,9 +53,9 @@ import sympy
 
 from .accuracy import ExpansionValidityWarning, branch_bound, displacement_error, gauge_values, phase_warning, series_warning
 from .assumptions import DerivationAssumptions, shown_values
-from .._errors import OrderError, ParameterError
+from .._errors import OrderError, ParameterError, UnsupportedNonlinearityError
 from ..algebra.branch import Branch, EvaluationPoint
-from ..problems.oscillator import Oscillator
+from ..problems.oscillator import Oscillator, _decided_sign, reduce_quadratic
 from ..engine.branches import BranchHierarchy, FloatBranches
 from ..engine.contact import PiecewiseNormalForm
 from ..engine.smooth import MAX_ORDER, NormalForm, SmoothHierarchy
@@ -199,6 +207,133 @@ class PiecewiseWaveform:
         }
 
 
+def _series_power(coefficients: list[sympy.Expr], power: int, order: int) -> sympy.Expr:
+    """The x^order coefficient of (Σ_{k≥1} coefficients[k] x^k)^power (coefficients[0] is ignored; missing ones
+    are zero: for power ≥ 2 the x^order coefficient does not involve coefficients[order])."""
+    coefficients = list(coefficients) + [sympy.Integer(0)] * (order + 1 - len(coefficients))
+    table = [sympy.Integer(1)] + [sympy.Integer(0)] * order
+    for _ in range(power):
+        table = [sympy.Add(*[coefficients[k] * table[j - k] for k in range(1, j + 1) if table[j - k] != 0]) for j in range(order + 1)]
+    return table[order]
+
+
+def _at_angle(expression: sympy.Expr, cosine: sympy.Expr, sine: sympy.Expr, angle: sympy.Expr) -> sympy.Expr:
+    """An expression in s (polynomial in s, cos(n s), sin(n s)) at s = angle, with cos angle, sin angle given exactly."""
+    s = STRAINED_TIME
+    if any(atom.args[0] != s for atom in expression.atoms(sympy.cos, sympy.sin) if atom.has(s)):
+        expression = sympy.expand_trig(expression)
+    return expression.xreplace({sympy.cos(s): cosine, sympy.sin(s): sine}).xreplace({s: angle})
+
+
+def _tidy(value: sympy.Expr, angle: sympy.Expr) -> sympy.Expr:
+    """A phase coefficient as a polynomial in the angle ψ0 (float hierarchies: evaluated)."""
+    if value.has(sympy.Float):
+        return value.evalf()
+    if value.free_symbols:  # symbolic ω0 or parameters: one rational function (the angle is one of its generators)
+        return sympy.cancel(value)
+    return sympy.collect(sympy.expand(value), angle)
+
+
+def _phase_coefficients(expansion: "Expansion", highest: int) -> tuple[sympy.Expr, ...]:
+    """φ_0 … φ_highest of the orbit through (u0, v0), v0 ≠ 0 (see :attr:`Expansion.phase`)."""
+    problem = expansion.problem
+    start, speed, omega0, amplitude = problem.u0, abs(problem.v0), problem.omega0, problem.a0
+    sign = -1 if problem.v0 > 0 else 1  # φ = ∓ψ: v0 > 0 means the orbit is before its positive turning point
+    angle = sympy.atan2(speed / omega0, start)  # ψ0 in (0, π)
+    # Symbolic ω0 or parameters: compute in K(a), a = A0 (a² = u0² + v0²/ω0²), so that no radicals pile up.
+    to_field, reduce, output = _quadratic_field(problem) if problem.free_symbols else (None, None, None)
+    a = amplitude if to_field is None else to_field(amplitude)
+    cosine, sine = start / a, speed / (omega0 * a)  # cos ψ0, sin ψ0 > 0
+    piece = 0
+    if expansion.is_piecewise:
+        for index, boundary in enumerate(expansion._form.boundaries):  # by increasing angle, i.e. decreasing κ
+            side = _decided_sign(sympy.simplify(boundary.kappa - cosine), "u0 against a breakpoint")
+            if side == 0:  # u0 on a crossed breakpoint: ψ(ε) is the moving contact angle s*(ε)
+                shifts = [expansion.contact_angle_correction(k)[index] for k in range(1, highest + 1)]
+                return tuple(sign * value for value in (expansion.contact_angles[index], *shifts))
+            piece += side > 0
+        arcs = expansion._form.system.arcs
+        last = len(expansion._form.boundaries)
+        if (piece == 0 and arcs[0] is not None) or (piece == last and arcs[1] is not None):
+            raise UnsupportedNonlinearityError(
+                f"u(0) = {start} lies on a stretched contact arc (non-polynomial law), whose waveform is computed numerically "
+                "on a stretched interval (no closed-form branch to expand the phase from); start the orbit outside that "
+                "contact (another point u0, v0 of the same orbit), or release it at rest with a0= instead of u0/v0"
+            )
+    waveforms: dict[int, Any] = {}
+    derivatives: dict[tuple[int, int], sympy.Expr] = {}
+
+    def derivative(k: int, m: int) -> sympy.Expr:
+        """v_k^{(m)}(ψ0), exact (the branch of the piece containing ψ0 for piecewise f)."""
+        if (k, m) not in derivatives:
+            if k not in waveforms:
+                waveforms[k] = expansion.waveform(k)
+            waveform = waveforms[k]
+            if isinstance(waveform, Waveform):
+                total = sympy.Integer(0)
+                for harmonic, value in waveform.coefficients:
+                    value = value if to_field is None else to_field(value)
+                    cos_n = sympy.chebyshevt(harmonic, cosine)
+                    sin_n = sine * sympy.chebyshevu(harmonic - 1, cosine) if harmonic else sympy.Integer(0)
+                    trig = (cos_n, -sin_n, -cos_n, sin_n)[m % 4]
+                    total += value * harmonic**m * trig
+            else:
+                branch = sympy.diff(waveform.branches[piece], STRAINED_TIME, m)
+                if to_field is not None:
+                    branch = to_field(branch)
+                total = _at_angle(branch, cosine, sine, angle)
+            derivatives[k, m] = reduce(total) if reduce is not None else total
+        return derivatives[k, m]
+
+    psi: list[sympy.Expr] = [angle]
+    slope = -speed / omega0  # v_0'(ψ0) = −A0 sin ψ0
+    for n in range(1, highest + 1):
+        total = derivative(n, 0)
+        for k in range(0, n):
+            for m in range(1, n - k + 1):
+                if k == 0 and m == 1:
+                    continue  # the unknown ψ_n
+                power = _series_power(psi, m, n - k)
+                if power != 0:
+                    total += derivative(k, m) * power / math.factorial(m)
+        psi.append(_tidy(-total / slope, angle) if reduce is None else reduce(-total / slope))
+    if output is not None:
+        psi = [output(value) for value in psi]
+    return tuple(sign * value for value in psi)
+
+
+def _quadratic_field(problem: Oscillator) -> tuple[Callable, Callable, Callable] | tuple[None, None, None]:
+    """(to_field, reduce, output) for arithmetic in K(a), a = A0 = (u0² + v0²/ω0²)^{1/2} of a symbolic problem:
+    ``to_field`` writes the half-integer powers of A0's radicand through a, ``reduce`` gives the canonical
+    P + Q a, ``output`` puts A0 back.  (None, None, None) when A0 is not one square root times a rational factor."""
+    amplitude = problem.a0
+    roots = [atom for atom in amplitude.atoms(sympy.Pow) if atom.exp == sympy.Rational(1, 2)]
+    if len(roots) != 1:
+        return None, None, None
+    base = roots[0].base
+    factor = sympy.cancel(amplitude / roots[0])  # A0 = sqrt(base)·factor
+    if factor.has(base):
+        return None, None, None
+    generator = sympy.Dummy("A0", positive=True)
+    square = sympy.expand(problem.u0**2 + problem.v0**2 / problem.omega0**2)
+
+    def to_field(expression: sympy.Expr) -> sympy.Expr:
+        powers = {
+            atom: (generator / factor) ** int(2 * atom.exp)
+            for atom in expression.atoms(sympy.Pow)
+            if atom.base == base and (2 * atom.exp).is_Integer and not atom.exp.is_Integer
+        }
+        return expression.xreplace(powers) if powers else expression
+
+    def reduce(expression: sympy.Expr) -> sympy.Expr:
+        return reduce_quadratic(expression, generator, square)
+
+    def output(expression: sympy.Expr) -> sympy.Expr:
+        return expression.xreplace({generator: amplitude})
+
+    return to_field, reduce, output
+
+
 @dataclass(frozen=True)
 class Expansion:
     """Lindstedt–Poincaré expansion of an :class:`~lindstedt.Oscillator` to a given order.
@@ -273,6 +408,7 @@ class Expansion:
         """σ_{i,order}: the ε^order coefficient of the moving contact angles s_i*(ε) (empty for smooth f)."""
         if not self._form.boundaries:
             return ()
+        self._check(order)
         return tuple(self._to_expr(value, order, sympy.Integer(1)) for value in self._hierarchy.boundary_shift(order))
 
     # -- exact quantities ---------------------------------------------------------------
@@ -280,19 +416,29 @@ class Expansion:
         """prefactor · (ε̂/ε)^power · element: a coefficient of the normalised hierarchy in the problem's units."""
         return self._form.scaled_expr(element, power, prefactor)
 
-    def _check(self, order: int) -> None:
+    def _check(self, order: int, frequency: bool = False) -> None:
         highest = self._steps * (MAX_ORDER + 1)
         if isinstance(order, bool) or not isinstance(order, int) or order < 0 or order > highest:
             raise OrderError(f"correction index must be an integer in [0, {highest}], got {order!r}")
+        released = self.problem.release_order
+        # from (u0, v0) the engine knows the turning point through A_M: waveforms and contact angles through the
+        # gauge index s·M, ω and α (which need the waveforms before them) through s·M + 1
+        reach = None if released is None else self._steps * released + (1 if frequency else 0)
+        if reach is not None and order > reach:
+            raise OrderError(
+                f"correction index {order} is beyond what the turning-point series A_1 … A_{released} of this expansion "
+                f"from (u0, v0) determines (index {reach}); expand to a higher order: "
+                f"lindstedt.expand(..., order={max(self.order, -(-(order - (1 if frequency else 0)) // self._steps) - 1)})"
+            )
 
     def omega_correction(self, order: int) -> sympy.Expr:
-        """Exact ω_order (any order, computed lazily; beyond ``self.order`` allowed)."""
-        self._check(order)
+        """Exact ω_order (any order, computed lazily; beyond ``self.order`` allowed, from (u0, v0) up to order + 1)."""
+        self._check(order, frequency=True)
         return self._to_expr(self._hierarchy.frequency(order), order, self.problem.omega0)
 
     def alpha_correction(self, order: int) -> sympy.Expr:
         """Exact α_order, the ε^order coefficient of ω²."""
-        self._check(order)
+        self._check(order, frequency=True)
         return self._to_expr(self._hierarchy.squared_frequency(order), order, self.problem.omega0**2)
 
     def waveform(self, order: int) -> Waveform | PiecewiseWaveform:
@@ -332,6 +478,53 @@ class Expansion:
     def waveforms(self) -> tuple[Waveform | PiecewiseWaveform, ...]:
         """(v_0, …, v_N), exact cosine polynomials."""
         return tuple(self.waveform(k) for k in range(self._steps * self.order + 1))
+
+    @cached_property
+    def amplitude(self) -> tuple[sympy.Expr, ...]:
+        """(A_0, …, A_N): the turning point ``v(0; ε) = Σ_k A_k gauge^k`` the expansion is released at, exact.
+
+        General initial data (u0, v0): the positive turning point of the orbit through them, from
+        the energy (:meth:`Oscillator.amplitude_series`).  A release at rest: ``(a0, a1, 0, …)``;
+        ``"harmonic"`` normalization: ``v_k(0)``.  Indexed like :attr:`omega` (powers of the gauge).
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> lindstedt.expand("Max(0, u - 1/4)", order=2, u0="3/5", v0="4/5", omega0=1).amplitude
+        (1, -11/50, 88/625)
+        """
+        highest = self._steps * self.order
+        if self.problem.normalization == "harmonic":
+            return tuple(self.waveform(k).value_at_zero() for k in range(highest + 1))
+        series = self.problem.amplitude_series(self.order)
+        values = [sympy.Integer(0)] * (highest + 1)
+        for k, value in enumerate(series):
+            values[self._steps * k] = value
+        return tuple(values)
+
+    @cached_property
+    def phase(self) -> tuple[sympy.Expr, ...]:
+        """(φ_0, …, φ_N): the phase ``φ(ε) = Σ_k φ_k gauge^k`` of ``u(t) = v(ω t + φ(ε); ε)``, exact.
+
+        Zero for a release at rest.  From (u0, v0): ``v(φ; ε) = u0`` with the sign of
+        ``u'(0) = ω v_s(φ) = v0``, i.e. ``φ_0 = atan2(−v0/ω0, u0)`` and φ_k from the Taylor
+        expansion of the waveforms at φ_0: with ψ = |φ| = ψ_0 + Δ, Δ = Σ_{k≥1} ψ_k gauge^k,
+        ``Σ_{k,m} v_k^{(m)}(ψ_0) [Δ^m]_{n−k}/m! = 0`` at order n ≥ 1, which is linear in ψ_n
+        through ``v_0'(ψ_0) = −|v0|/ω0``.  For piecewise f the branch of the piece that
+        contains ψ_0 is used (its analytic continuation); if u0 sits on a crossed breakpoint
+        the phase is the moving contact angle itself, ψ = s*(ε) (:meth:`contact_angle_correction`).
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> e = lindstedt.expand("u**3", order=1, u0=0, v0=1, omega0=1)   # kicked from equilibrium
+        >>> e.phase
+        (-pi/2, 0)
+        """
+        highest = self._steps * self.order
+        if not self.problem.has_initial_velocity:
+            return tuple(sympy.Integer(0) for _ in range(highest + 1))
+        return _phase_coefficients(self, highest)
 
     @cached_property
     def omega_next(self) -> sympy.Expr:
@@ -489,14 +682,23 @@ class Expansion:
             message = phase_warning(drift, times)
         if message:
             warnings.warn(ExpansionValidityWarning(message), stacklevel=3)
-        strained = times * frequency
+        strained = times * frequency + self._phase_value(gauge, values)
         result = amplitude * branches.evaluate(strained, scale ** (1 / self._steps) * gauge, derivative)[..., 0]
         if derivative:
             result = result * frequency
         return result if result.ndim else float(result)
 
+    def _phase_value(self, gauge: float, values: Mapping[Any, Any] | None) -> float:
+        """φ(ε) = Σ_{k≤N} φ_k gauge^k as a float (0 for a release at rest)."""
+        if not self.problem.has_initial_velocity:
+            return 0.0
+        coefficients = self._cached("phase", values, lambda: self._floats(list(self.phase), values))
+        return float(np.polynomial.polynomial.polyval(gauge, coefficients))
+
     def displacement(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None = None) -> np.ndarray:
-        """u(t) ≈ Σ_{k≤N} ε^k v_k(ω t), ω through ω_{N+1}; vectorised over ``t``.
+        """u(t) ≈ Σ_{k≤N} ε^k v_k(ω t + φ(ε)), ω through ω_{N+1}, φ through φ_N; vectorised over ``t``.
+
+        The phase φ(ε) is zero for a release at rest (see :attr:`phase` for initial data u0, v0).
 
         For piecewise-linear f the branches are used up to the *moving* contact
         angles s_i*(ε) = β_i + Σ σ_{i,k} ε^k, so the error stays O(ε^{N+1}).
@@ -520,17 +722,34 @@ class Expansion:
         last = self._steps * (self.order if order is None else order)
         return sympy.Add(*[self.omega_correction(k) * self.gauge**k for k in range(last + 1)])
 
+    def phase_expr(self, order: int | None = None) -> sympy.Expr:
+        """φ(ε) truncated at ``order`` as a sympy polynomial in ``epsilon`` (0 for a release at rest)."""
+        last = self._steps * (self.order if order is None else order)
+        if not self.problem.has_initial_velocity:
+            return sympy.Integer(0)
+        if last > self._steps * self.order:
+            raise OrderError(f"the phase series holds orders up to {self.order}; expand to a higher order")
+        return sympy.Add(*[self.phase[k] * self.gauge**k for k in range(last + 1)])
+
+    def amplitude_expr(self, order: int | None = None) -> sympy.Expr:
+        """A(ε), the turning point the expansion is released at, truncated at ``order`` (see :attr:`amplitude`)."""
+        last = self._steps * (self.order if order is None else order)
+        if last > self._steps * self.order:
+            raise OrderError(f"the amplitude series holds orders up to {self.order}; expand to a higher order")
+        return sympy.Add(*[self.amplitude[k] * self.gauge**k for k in range(last + 1)])
+
     def displacement_expr(self) -> sympy.Expr:
-        """u(t; ε) = Σ_{k≤N} ε^k v_k(ω t) with ω through ω_{N+1}, as a sympy expression.
+        """u(t; ε) = Σ_{k≤N} ε^k v_k(ω t + φ(ε)) with ω through ω_{N+1}, as a sympy expression.
 
         For piecewise-linear f the strained time is folded to [0, π]
         (evenness, 2π-periodicity) and the pieces end at the moving contact
         angles s_i*(ε) = β_i + Σ_{k≤N} σ_{i,k} ε^k, as in :meth:`displacement`.
         """
         frequency = self.frequency_expr(self.order) + self.omega_next * self.gauge ** (self._steps * self.order + 1)
+        strained = frequency * TIME + self.phase_expr()
         if not self.is_piecewise:
-            return sympy.Add(*[EPSILON**w.order * w.to_expr(frequency * TIME) for w in self.waveforms])
-        folded = sympy.Abs(sympy.Mod(frequency * TIME + sympy.pi, 2 * sympy.pi) - sympy.pi)
+            return sympy.Add(*[EPSILON**w.order * w.to_expr(strained) for w in self.waveforms])
+        folded = sympy.Abs(sympy.Mod(strained + sympy.pi, 2 * sympy.pi) - sympy.pi)
         pieces = [sympy.Add(*[self.gauge**w.order * w.branches[p] for w in self.waveforms]) for p in range(len(self.waveforms[0].branches))]
         boundaries = [
             sympy.Add(*[self.gauge**k * self.contact_angle_correction(k)[index] for k in range(1, self._steps * self.order + 1)], angle)
@@ -575,7 +794,9 @@ class Expansion:
         equation = (
             r"\ddot u + " + _latex(problem.omega0**2) + r" u + \varepsilon\left(" + _latex(problem.f.subs(problem.variable, u)) + r"\right) = 0"
         )
-        if problem.normalization == "initial":
+        if problem.has_initial_velocity:
+            condition = r"u(0) = " + _latex(problem.u0) + r",\ \dot u(0) = " + _latex(problem.v0)
+        elif problem.normalization == "initial":
             release = _latex(problem.a0) + ("" if problem.a1 == 0 else r" + \varepsilon " + _latex(problem.a1))
             condition = r"u(0) = " + release + r",\ \dot u(0) = 0"
         else:
@@ -583,7 +804,12 @@ class Expansion:
         lines = [r"& " + equation + r",\quad " + condition]
         for exponent, value in zip(self.exponents, self.omega):  # ω_{k/2} multiplies ε^{k/2} in the gauge sqrt(ε)
             lines.append(rf"\omega_{{{exponent}}} &= {_latex(value)}")
-        lines.append(r"\omega(\varepsilon) &= " + _latex(self.frequency_expr()) + rf" + O(\varepsilon^{{{_latex(sympy.Rational(self._steps * self.order + 1, self._steps))}}})")
+        remainder = rf" + O(\varepsilon^{{{_latex(sympy.Rational(self._steps * self.order + 1, self._steps))}}})"
+        lines.append(r"\omega(\varepsilon) &= " + _latex(self.frequency_expr()) + remainder)
+        if problem.has_initial_velocity:
+            lines.append(r"u(t) &= v(\omega t + \varphi(\varepsilon); \varepsilon),\quad v(0; \varepsilon) = A(\varepsilon)")
+            lines.append(r"A(\varepsilon) &= " + _latex(self.amplitude_expr()) + remainder)
+            lines.append(r"\varphi(\varepsilon) &= " + _latex(self.phase_expr()) + remainder)
         if waveforms:
             for waveform in self.waveforms:
                 lines.append(rf"v_{{{waveform.order}}}(s) &= {waveform.to_latex()}")
@@ -614,6 +840,15 @@ class Expansion:
             "alpha_float": [_as_float(value) for value in self.alpha],
             "omega_next": sympy.sstr(self.omega_next),
         }
+        if problem.has_initial_velocity:
+            data["problem"]["equation"] = "u'' + omega0**2*u + epsilon*f(u) = 0, u(0) = u0, u'(0) = v0"
+            data["problem"]["u0"] = sympy.sstr(problem.u0)
+            data["problem"]["v0"] = sympy.sstr(problem.v0)
+            data["solution"] = "u(t) = v(omega*t + phase; epsilon), v(0; epsilon) = amplitude (positive turning point)"
+            data["amplitude"] = [sympy.sstr(value) for value in self.amplitude]
+            data["amplitude_float"] = [_as_float(value) for value in self.amplitude]
+            data["phase"] = [sympy.sstr(value) for value in self.phase]
+            data["phase_float"] = [_as_float(value) for value in self.phase]
         if waveforms:
             data["waveforms"] = [
                 w.to_dict()
@@ -638,4 +873,8 @@ class Expansion:
             lines.append(f"  omega(eps) = sum_k omega_k {self.gauge}**k (grazing: not analytic in eps)")
         for k, value in enumerate(self.omega):
             lines.append(f"  omega_{k} = {value}")
+        if self.problem.has_initial_velocity:
+            lines.append("  u(t) = v(omega*t + phi(eps); eps), released at the turning point A(eps) = v(0; eps) > 0")
+            lines += [f"  A_{k} = {value}" for k, value in enumerate(self.amplitude)]
+            lines += [f"  phi_{k} = {value}" for k, value in enumerate(self.phase)]
         return "\n".join(lines)

@@ -1,4 +1,5 @@
-"""The true solution u(t) of  u'' + ω0² u + ε f(u) = 0,  u(0) = a0 + ε a1,  u'(0) = 0,  and its exact period.
+"""The true solution u(t) of  u'' + ω0² u + ε f(u) = 0,  u(0) = a0 + ε a1,  u'(0) = 0  (or u(0) = u0,
+u'(0) = v0 for a problem built from general initial data),  and its exact period.
 
 Reference (:func:`reference_solution`)
     * continuous piecewise-linear f (unilateral springs ``a·(u − b)_+``, several
@@ -17,7 +18,9 @@ Reference (:func:`reference_solution`)
 Period (:func:`exact_period`)
     ``P = 2 t_½`` with ``t_½`` the first positive zero of ``u'``: the motion
     from ``u'(0) = 0`` is even about ``t = 0`` and about every turning point
-    (the equation is conservative and reversible).
+    (the equation is conservative and reversible).  From ``u'(0) = v0 ≠ 0``:
+    ``P = 2 (t_2 − t_1)`` with ``t_1 < t_2`` the first two zeros of ``u'``
+    (consecutive turning points).
 
 The private helpers here turn an :class:`~lindstedt.Oscillator` or an
 :class:`~lindstedt.Expansion` into floats (ω0, a0, the linear pieces of f) and
@@ -154,9 +157,17 @@ def _numeric_problem(source: Oscillator | Expansion, values: Mapping[Any, Any] |
     return _NumericProblem(omega0, a0, nonlinearity, law, problem.is_non_smooth)
 
 
+def _initial_velocity(source: Oscillator | Expansion) -> float:
+    """u'(0): v0 of a problem built from general initial data, else 0 (a release at rest)."""
+    problem = _problem_of(source)
+    return float(problem.v0) if problem.has_initial_velocity else 0.0
+
+
 def _initial_displacement(source: Oscillator | Expansion, numeric: _NumericProblem, epsilon: float,
                           a1: float, values: Mapping[Any, Any] | None) -> float:
     problem = _problem_of(source)
+    if problem.has_initial_velocity:
+        return float(problem.u0) + epsilon * a1  # u(0) = u0 exactly (a0 is the orbit's turning point)
     if problem.normalization == "harmonic":
         assert isinstance(source, Expansion)
         start = float(np.asarray(source.displacement(0.0, epsilon, values)))
@@ -171,7 +182,7 @@ def _initial_displacement(source: Oscillator | Expansion, numeric: _NumericProbl
 # --------------------------------------------------------------------------- #
 @dataclass(frozen=True)
 class ReferenceSolution(JsonExport):
-    """The true solution of ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = u0``, ``u'(0) = 0``.
+    """The true solution of ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = u0``, ``u'(0) = v0`` (0 unless the problem has v0).
 
     Attributes
     ----------
@@ -184,6 +195,8 @@ class ReferenceSolution(JsonExport):
         ``"DOP853-piecewise"`` (restarted at every breakpoint crossing).
     epsilon, initial_displacement : float
         ε and u(0).
+    initial_velocity : float
+        u'(0) (0 for a release at rest).
     times, displacement, velocity : numpy.ndarray
         The requested times and u, u' there.
     t_final : float
@@ -217,6 +230,7 @@ class ReferenceSolution(JsonExport):
     n_arcs: int
     _evaluator: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] = field(repr=False, compare=False)
     problem: Oscillator | None = field(default=None, repr=False, compare=False)
+    initial_velocity: float = 0.0
 
     def state(self, t: Any) -> tuple[np.ndarray, np.ndarray]:
         """Dense output: ``(u(t), u'(t))`` for any times in ``[0, t_final]``, shaped like ``t``."""
@@ -250,7 +264,7 @@ def _flow_outcome(flow: FlowResult, method: str, message: str, n_switches: int,
 
 
 def _exact_piecewise_flow(law: _PiecewiseLaw, omega0: float, epsilon: float, u0: float,
-                          t_end: float) -> tuple[FlowResult, float]:
+                          t_end: float, v0: float = 0.0) -> tuple[FlowResult, float]:
     """ExactFlow of the shifted system; returns the flow and the shift c (u = x + c)."""
     if not law.continuous:
         raise ProblemError("f jumps at a breakpoint, which no spring of the exact flow represents")
@@ -270,16 +284,16 @@ def _exact_piecewise_flow(law: _PiecewiseLaw, omega0: float, epsilon: float, u0:
         system = UnilateralSystem(
             M=[[1]], K=[[stiffness]], A=[[1]] * len(active), b=[gap for gap, _ in active], W=[[jump for _, jump in active]]
         )
-    flow = ExactFlow(system, epsilon).solve([u0 - shift], [0.0], t_end)
+    flow = ExactFlow(system, epsilon).solve([u0 - shift], [v0], t_end)
     return flow, shift
 
 
 def _piecewise_dop853(law: _PiecewiseLaw, omega0: float, epsilon: float, u0: float, t_end: float,
-                      rtol: float, atol: float) -> _Outcome:
+                      rtol: float, atol: float, v0: float = 0.0) -> _Outcome:
     """DOP853 on one linear piece at a time, restarted at each breakpoint crossing."""
     omega2 = omega0 * omega0
     segments: list[tuple[float, float, Any]] = []
-    t, u, v = 0.0, u0, 0.0
+    t, u, v = 0.0, u0, v0
     n_evaluations = n_switches = 0
     success, message = True, ""
     max_segments = 1_000_000
@@ -327,7 +341,7 @@ def _piecewise_dop853(law: _PiecewiseLaw, omega0: float, epsilon: float, u0: flo
         positions = np.empty(times.size)
         velocities = np.empty(times.size)
         if not segments:
-            positions[:], velocities[:] = u0, 0.0
+            positions[:], velocities[:] = u0, v0
             return positions, velocities
         index = np.clip(np.searchsorted(starts, times, side="right") - 1, 0, len(segments) - 1)
         for k in np.unique(index):
@@ -349,14 +363,15 @@ def reference_solution(
     rtol: float = DEFAULT_RTOL,
     atol: float = DEFAULT_ATOL,
 ) -> ReferenceSolution:
-    """The true u(t) of ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0 + ε a1``, ``u'(0) = 0``.
+    """The true u(t) of ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0 + ε a1``, ``u'(0) = 0``
+    (``u(0) = u0 + ε a1``, ``u'(0) = v0`` for a problem built from general initial data).
 
     Parameters
     ----------
     source : Oscillator or Expansion
         The problem (an Expansion's problem is used).  With
         ``normalization="harmonic"`` an Expansion is required: its ``u(0)`` at
-        this ε is the initial displacement.
+        this ε is the initial displacement.  A problem from ``u0``, ``v0`` starts there.
     epsilon : float
         The small parameter ε ≥ 0.
     t : float or array_like
@@ -383,6 +398,9 @@ def reference_solution(
     >>> duffing = reference_solution(lindstedt.Oscillator("u**3", a0=1, omega0=1), 0.0, [np.pi])
     >>> duffing.method, abs(float(duffing.displacement[0]) + 1.0) < 1e-10
     ('DOP853', True)
+    >>> kicked = reference_solution(lindstedt.Oscillator("Max(0, u)", u0=0, v0=1, omega0=1), 3.0, [np.pi / 4])
+    >>> round(float(kicked.displacement[0]), 12), kicked.initial_velocity   # contact arc: sin(2t)/2
+    (0.5, 1.0)
     """
     eps = _as_epsilon(epsilon)
     times = np.asarray(t, dtype=float)
@@ -391,18 +409,19 @@ def reference_solution(
     a1_value = _as_real(a1, "a1")
     numeric = _numeric_problem(source, values)
     u0 = _initial_displacement(source, numeric, eps, a1_value, values)
+    v0 = _initial_velocity(source)
     t_end = float(times.max())
     if numeric.law is not None:
         try:
-            flow, shift = _exact_piecewise_flow(numeric.law, numeric.omega0, eps, u0, t_end)
+            flow, shift = _exact_piecewise_flow(numeric.law, numeric.omega0, eps, u0, t_end, v0)
         except ProblemError as error:
-            outcome = _piecewise_dop853(numeric.law, numeric.omega0, eps, u0, t_end, rtol, atol)
+            outcome = _piecewise_dop853(numeric.law, numeric.omega0, eps, u0, t_end, rtol, atol, v0)
             outcome = outcome._replace(message=f"{outcome.message} (exact flow unavailable: {error})")
         else:
             outcome = _flow_outcome(flow, "exact", flow.message, flow.n_switches, shift)
     else:
         function = sympy.lambdify(DISPLACEMENT, numeric.nonlinearity, modules="math")
-        flow = smooth_flow(lambda u: float(function(u)), numeric.omega0, eps, u0, 0.0, t_end, rtol, atol)
+        flow = smooth_flow(lambda u: float(function(u)), numeric.omega0, eps, u0, v0, t_end, rtol, atol)
         message = flow.message
         if numeric.is_non_smooth:
             message += " (non-smooth f that is not piecewise linear: DOP853 across its kinks, reduced accuracy)"
@@ -424,6 +443,7 @@ def reference_solution(
         n_arcs=int(outcome.n_arcs),
         _evaluator=outcome.evaluator,
         problem=_problem_of(source),
+        initial_velocity=v0,
     )
 
 
@@ -476,13 +496,17 @@ def exact_period(
 
     The motion from ``u'(0) = 0`` is even about ``t = 0`` and about each
     turning point (the equation is conservative and reversible), so the
-    second turning point is at half the period.
+    second turning point is at half the period.  From ``u'(0) = v0 ≠ 0`` (a problem
+    built from u0, v0) the half period is the time between the first two zeros of u'.
 
     Examples
     --------
     >>> import lindstedt
     >>> p = exact_period(lindstedt.Oscillator("Max(0, u)", a0=1, omega0=1), 3.0)
     >>> round(p.period, 12) == round(np.pi / 2 + np.pi, 12)      # π/ω' + π/ω0 with ω' = 2
+    True
+    >>> kicked = exact_period(lindstedt.Oscillator("Max(0, u)", u0="-1/2", v0=1, omega0=1), 3.0)
+    >>> round(kicked.period, 12) == round(np.pi / 2 + np.pi, 12)  # the same orbit family: P does not depend on the amplitude
     True
     """
     numeric = _numeric_problem(source, values)
@@ -499,11 +523,23 @@ def exact_period(
         counter[0] += 1
         return float(reference.state(np.array([t]))[1][0])
 
+    moving = _initial_velocity(source) != 0.0
+    if moving:  # from u'(0) ≠ 0: the first two zeros of u' are consecutive turning points
+        start_sign = np.sign(velocity[0])
+        first = np.flatnonzero(np.sign(velocity[1:]) == -start_sign)
+        second = np.flatnonzero(np.sign(velocity[1:]) == start_sign)
+        second = second[second > first[0]] if first.size else second[:0]
+        changes = second
     if start_sign == 0 or changes.size == 0:
         return ExactPeriod(False, "u' has no positive zero within two linear periods (rest state or too large ε?)",
                            math.nan, math.nan, counter[0], reference.method, problem=_problem_of(source))
-    k = int(changes[0]) + 1
-    half = float(scipy.optimize.brentq(speed, grid[k - 1], grid[k], xtol=1e-15, rtol=4 * np.finfo(float).eps))
+
+    def zero(index: int) -> float:
+        return float(scipy.optimize.brentq(speed, grid[index], grid[index + 1], xtol=1e-15, rtol=4 * np.finfo(float).eps))
+
+    half = zero(int(changes[0]))
+    if moving:
+        half -= zero(int(first[0]))
     return ExactPeriod(
         success=reference.success,
         message=f"P = {2 * half:.16g} ({reference.method}); {reference.message}",
