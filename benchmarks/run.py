@@ -37,6 +37,7 @@ REGISTRY: dict[str, tuple[str, str]] = {
     "nnm-scaling": ("bench_nnm_scaling", "run"),
     "method-pairs": ("bench_method_pairs", "run"),
     "codegen-stability": ("bench_codegen_stability", "run"),
+    "contact-laws": ("bench_contact_laws", "run"),
 }
 
 
