@@ -193,6 +193,8 @@ class Sheet:
             rf" with $s = \omega(\varepsilon)\, t$; first terms {shown}{extension}:" + "\n"
             + align([rf"v_{{{w.order}}}(s) &= {w.to_latex()}" for w in waveforms])
         )
+        if expansion.stretched_arcs:  # pieces with a non-polynomial contact law: Y_k(τ), expanded in stretched time
+            parts.append("\n\n".join(arc.to_latex() for arc in expansion.stretched_arcs))
         angles, exponent = expansion.contact_angles, expansion.validity_exponent
         angle_text = ""
         if angles:

@@ -34,11 +34,11 @@ from lindstedt.references import (
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 SCRIPTS = REPOSITORY / "derivations"
-NAMES = ["duffing", "u_plus", "gap", "prestress", "negative_release", "grazing", "nnm_2dof", "nnm_5dof", "all_modes"]
+NAMES = ["duffing", "u_plus", "gap", "prestress", "negative_release", "grazing", "nnm_2dof", "nnm_5dof", "all_modes", "hertz"]
 #: Small orders keep the suite fast; each still exercises the order-2 machinery where there is one.
 SMALL_ORDER = {
     "duffing": 4, "u_plus": 3, "gap": 2, "prestress": 2, "negative_release": 2,
-    "grazing": 2, "nnm_2dof": 2, "nnm_5dof": 1, "all_modes": 1,
+    "grazing": 2, "nnm_2dof": 2, "nnm_5dof": 1, "all_modes": 1, "hertz": 2,
 }
 PIECEWISE_TOLERANCE = 1e-20  # absolute, ω_k against the 40-digit Cauchy-integral reference
 NNM_TOLERANCE = 1e-25  # absolute, 30-digit N-dof arithmetic against closed forms

@@ -113,3 +113,25 @@ def test_what_the_stretched_arc_does_not_cover_is_refused_with_the_fix():
         lindstedt.expand("Max(0, u - 1/5)*exp(u)*Heaviside(1/2 - u)", order=2, a0=1, omega0=1)
     with pytest.raises(lindstedt.UnsupportedNonlinearityError, match="not linear in u"):  # infinitely many breakpoints
         lindstedt.expand("Heaviside(sin(1/u))", order=2, a0=1, omega0=1)
+
+
+def test_the_stretched_arc_exports_itself_and_evaluates_like_the_expansion():
+    import json
+
+    expansion = lindstedt.expand("Max(0, u - 1/5)**(3/2)", order=2, a0=1, omega0=1, precision=20)
+    (arc,) = expansion.stretched_arcs
+    data = json.loads(expansion.to_json())
+    assert data["stretched_arcs"][0]["schema"] == "lindstedt.stretched-arc/1"
+    assert data["waveforms"][1]["stretched_pieces"] == [0]
+    # the exported series reproduces the displacement on the arc: u = a0 Σ ε^n Y_n(s/ℓ(ε))
+    epsilon = 0.05
+    length = sum(float(value) * epsilon**n for n, value in enumerate(arc.length))
+    omega = float(expansion.frequency(epsilon, order=expansion.order + 1))  # displacement's time scale: ω through ω_{N+1}
+    for tau in (0.0, 0.3, 0.9):
+        t = tau * length / omega
+        assert arc.value(tau, epsilon) == pytest.approx(float(expansion.displacement(t, epsilon)), abs=1e-13)
+    assert "Stretched contact arc" in expansion.to_latex(waveforms=True)
+    with pytest.raises(lindstedt.UnsupportedNonlinearityError, match="Expansion.displacement"):
+        expansion.displacement_expr()
+    with pytest.raises(lindstedt.UnsupportedNonlinearityError, match="spectrum"):
+        expansion.waveforms[1].cosine_coefficient(1)

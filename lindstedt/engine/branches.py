@@ -360,6 +360,11 @@ class BranchHierarchy(LazyOrders):
         """W_{order, component}(0)."""
         return self.branches(order)[0][component].evaluate(self.system.zero_point)
 
+    def arc_length(self, which: int, order: int) -> Any:
+        """ℓ_order of stretched arc ``which`` (0: first piece, ℓ = s_1*; 1: last piece, ℓ = π − s_L*)."""
+        self._ensure(order)
+        return self._arc_data[which]["length"][order]
+
     def float_branches(self, highest: int, to_float: Any = float) -> FloatBranches:
         """:class:`FloatBranches` of W_0 … W_highest, coefficients converted by ``to_float``."""
         terms = tuple(

@@ -355,6 +355,13 @@ class StretchedArc:
         self._pending = None
         self.counters["orders"] += 1
 
+    def series(self, order: int) -> tuple[list[Any], list[Any]]:
+        """Chebyshev coefficients (in x = 2v − 1) of Y_order and of dY_order/dτ (fixed orders only)."""
+        if order == 0:
+            with mpmath.workdps(self._working):
+                return self._coefficients(self._cos), self._coefficients([-self.beta * s for s in self._sin])
+        return self._series[order - 1]
+
     def mu(self, order: int) -> Any:
         """μ_order (fixed orders only)."""
         return self._mu[order]
@@ -373,9 +380,7 @@ class StretchedArc:
         size = self.nodes
         zeroth_values = np.zeros(size)
         zeroth_slopes = np.zeros(size)
-        with mpmath.workdps(self._working):
-            # Y_0 = cos βτ and its τ-slope −β sin βτ, interpolated on the same grid
-            zeroth = self._coefficients(self._cos), self._coefficients([-self.beta * s for s in self._sin])
+        zeroth = self.series(0)  # Y_0 = cos βτ and its τ-slope −β sin βτ, interpolated on the same grid
         zeroth_values[:] = [float(a) for a in zeroth[0]]
         zeroth_slopes[:] = [float(a) for a in zeroth[1]]
         values = [zeroth_values] + [np.array([float(a) for a in series[0]]) for series in self._series[:highest]]

@@ -46,11 +46,13 @@ import math
 import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, ClassVar, Mapping
 
+import mpmath
 import numpy as np
 import sympy
 
+from ..export.json import JsonExport
 from .accuracy import ExpansionValidityWarning, branch_bound, displacement_error, gauge_values, phase_warning, series_warning
 from .assumptions import DerivationAssumptions, shown_values
 from .._errors import OrderError, ParameterError, UnsupportedNonlinearityError
@@ -167,6 +169,9 @@ class PiecewiseWaveform:
     _pieces: tuple[Branch, ...] = field(repr=False, compare=False)
     _limits: tuple[EvaluationPoint, ...] = field(repr=False, compare=False)
     _convert: Any = field(repr=False, compare=False)
+    # pieces solved on a stretched arc (non-polynomial contact law): their branch is the placeholder
+    # Y_k(tau) of :class:`StretchedArcSeries` (no fixed-s closed form)
+    stretched: tuple[int, ...] = ()
 
     def to_expr(self, variable: sympy.Symbol = STRAINED_TIME) -> sympy.Expr:
         """Sympy ``Piecewise`` on [0, π] (extend evenly and 2π-periodically)."""
@@ -178,6 +183,11 @@ class PiecewiseWaveform:
         """Exact d_n = (2/π) ∫_0^π v_k(s) cos(ns) ds (1/π for n = 0)."""
         if not isinstance(harmonic, int) or harmonic < 0:
             raise ValueError("harmonic must be a non-negative integer")
+        if self.stretched:
+            raise UnsupportedNonlinearityError(
+                "a stretched contact arc has no fixed-s closed form: take the spectrum of Expansion.displacement "
+                "(lindstedt.expansion_spectrum) instead of exact cosine coefficients"
+            )
         total = None
         for piece, lower, upper in zip(self._pieces, self._limits, self._limits[1:]):
             value = piece.times_cosine(harmonic).integral(lower, upper)
@@ -204,6 +214,83 @@ class PiecewiseWaveform:
             "interval": "[0, pi], extended evenly and 2*pi-periodically",
             "breakpoints": [sympy.sstr(value) for value in self.breakpoints],
             "pieces": [sympy.sstr(branch) for branch in self.branches],
+            **({"stretched_pieces": list(self.stretched)} if self.stretched else {}),
+        }
+
+
+STRETCHED_TIME = sympy.Symbol("tau", nonnegative=True)
+
+
+@dataclass(frozen=True)
+class StretchedArcSeries(JsonExport):
+    """A contact arc with a non-polynomial law (Hertz, analytic), expanded in its own stretched time.
+
+    On the arc, ``u = sign · a0 · Σ_n ε̂^n Y_n(τ)`` with ``ε̂ = ε/ω0²`` (``gauge``'s variable),
+    ``τ = s/ℓ(ε)`` (``side = "release"``: the arc holds u(0); ``sign = +1``) or
+    ``τ = (π − s)/ℓ(ε)`` (``side = "far"``: the far turning point; ``sign = −1``), where
+    ``ℓ(ε) = Σ_n ℓ_n ε̂^n`` is the arc's half-length in strained time and
+    ``Y_n(τ) = Σ_k c_{n,k} T_k(2 (1 − τ)^{1/d} − 1)`` (Chebyshev polynomials T_k).  The
+    contact ends at τ = 1 for every ε, where Y = ``contact_point``.  ``mu`` are the
+    coefficients of μ = Ω²/ℓ², Ω = ω/ω0.  Numbers at the expansion's working precision.
+
+    Examples
+    --------
+    >>> import lindstedt
+    >>> arc = lindstedt.expand("Max(0, u)**(3/2)", order=1, a0=1, omega0=1, precision=20).stretched_arcs[0]
+    >>> arc.side, arc.denominator, round(float(arc.length[0]), 12)
+    ('release', 2, 1.570796326795)
+    """
+
+    SCHEMA: ClassVar[str] = "lindstedt.stretched-arc/1"
+
+    side: str
+    sign: int
+    denominator: int
+    exponent: str | None
+    contact_point: Any
+    length: tuple[Any, ...]
+    mu: tuple[Any, ...]
+    chebyshev: tuple[tuple[Any, ...], ...]
+    slope_chebyshev: tuple[tuple[Any, ...], ...]
+    digits: int
+
+    def value(self, tau: float, epsilon: float, omega0: float = 1.0) -> float:
+        """Σ_n ε̂^n Y_n(τ) in float arithmetic (the normalised displacement on the arc, before sign · a0)."""
+        x = 2.0 * (1.0 - tau) ** (1.0 / self.denominator) - 1.0
+        scaled = epsilon / omega0**2
+        return float(sum(scaled**n * np.polynomial.chebyshev.chebval(x, [float(c) for c in row]) for n, row in enumerate(self.chebyshev)))
+
+    def to_latex(self) -> str:
+        """The representation on the arc, as a LaTeX sentence."""
+        variable = r"s/\ell(\varepsilon)" if self.side == "release" else r"(\pi - s)/\ell(\varepsilon)"
+        power = "" if self.exponent is None else rf", contact law $\propto |u - b|^{{{self.exponent}}}$"
+        sign = "" if self.sign > 0 else "-"
+        length = " + ".join(rf"{mpmath.nstr(value, 12)}\,\hat\varepsilon^{{{n}}}" for n, value in enumerate(self.length))
+        return (
+            rf"Stretched contact arc ({self.side} side{power}): $u = {sign}a_0 \sum_n \hat\varepsilon^n Y_n(\tau)$, "
+            rf"$\tau = {variable}$, $\hat\varepsilon = \varepsilon/\omega_0^2$, $\ell(\varepsilon) = {length} + \dots$, "
+            rf"$Y_n(\tau) = \sum_k c_{{n,k}} T_k\bigl(2 (1 - \tau)^{{1/{self.denominator}}} - 1\bigr)$ "
+            rf"({len(self.chebyshev[0])} Chebyshev coefficients per order, {self.digits} digits; see to_json)."
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: every number as a decimal string at the working precision."""
+        def text(value: Any) -> str:
+            return mpmath.nstr(value, self.digits, min_fixed=-1, max_fixed=1) if not isinstance(value, str) else value
+
+        return {
+            "schema": self.SCHEMA,
+            "representation": "u = sign*a0*sum_n epsh**n * sum_k c[n][k]*T_k(2*(1 - tau)**(1/d) - 1), epsh = epsilon/omega0**2, "
+                              "tau = s/length (release side) or (pi - s)/length (far side), length = sum_n length[n]*epsh**n",
+            "side": self.side,
+            "sign": self.sign,
+            "d": self.denominator,
+            "exponent": self.exponent,
+            "contact_point": text(self.contact_point),
+            "length": [text(value) for value in self.length],
+            "mu": [text(value) for value in self.mu],
+            "chebyshev": [[text(value) for value in row] for row in self.chebyshev],
+            "slope_chebyshev": [[text(value) for value in row] for row in self.slope_chebyshev],
         }
 
 
@@ -442,13 +529,21 @@ class Expansion:
         return self._to_expr(self._hierarchy.squared_frequency(order), order, self.problem.omega0**2)
 
     def waveform(self, order: int) -> Waveform | PiecewiseWaveform:
-        """Exact v_order(s): a :class:`Waveform` (smooth f) or :class:`PiecewiseWaveform`."""
+        """Exact v_order(s): a :class:`Waveform` (smooth f) or :class:`PiecewiseWaveform`.
+
+        A piece on a stretched contact arc (non-polynomial contact law) holds the placeholder
+        ``Y_order(tau)``: its expansion is :attr:`stretched_arcs`.
+        """
         self._check(order)
         if self.is_piecewise:
             form = self._form
             pieces = tuple(components[0] for components in self._hierarchy.branches(order))
             scale = self.problem.a0 * form.epsilon_scale**order
-            branches = tuple(scale * piece.to_expr(STRAINED_TIME, form.to_expr) for piece in pieces)
+            branches = [scale * piece.to_expr(STRAINED_TIME, form.to_expr) for piece in pieces]
+            stretched = self._stretched_pieces
+            for piece in stretched:
+                branches[piece] = sympy.Function(f"Y_{order}")(STRETCHED_TIME)
+            branches = tuple(branches)
             limits = (form.system.zero_point, *[b.point for b in form.boundaries], form.system.pi_point)
             return PiecewiseWaveform(
                 order=order,
@@ -457,12 +552,47 @@ class Expansion:
                 _pieces=pieces,
                 _limits=limits,
                 _convert=lambda element, scale=scale: scale * form.to_expr(element),
+                stretched=stretched,
             )
         series = self._hierarchy.waveform(order)
         coefficients = tuple(
             (harmonic, self._to_expr(series.coefficient(harmonic), order, self.problem.a0)) for harmonic in series.harmonics
         )
         return Waveform(order=order, coefficients=coefficients)
+
+    @property
+    def _stretched_pieces(self) -> tuple[int, ...]:
+        if not self.is_piecewise:
+            return ()
+        first, last = self._form.system.arcs
+        return tuple(piece for piece, arc in ((0, first), (len(self._form.system.states) - 1, last)) if arc is not None)
+
+    @cached_property
+    def stretched_arcs(self) -> tuple[StretchedArcSeries, ...]:
+        """The contact arcs expanded in stretched time (non-polynomial contact laws; empty otherwise)."""
+        if not self.is_piecewise:
+            return ()
+        result = []
+        highest = self._steps * self.order
+        hierarchy = self._hierarchy
+        for which, arc in enumerate(self._form.system.arcs):
+            if arc is None:
+                continue
+            lengths = tuple(mpmath.mpf(hierarchy.arc_length(which, n)) for n in range(highest + 1))
+            series = [arc.series(n) for n in range(highest + 1)]
+            result.append(StretchedArcSeries(
+                side="release" if which == 0 else "far",
+                sign=1 if which == 0 else -1,
+                denominator=arc.denominator,
+                exponent=None if arc.exponent is None else str(arc.exponent),
+                contact_point=arc.kappa,
+                length=lengths,
+                mu=tuple(arc.mu(n) for n in range(highest + 1)),
+                chebyshev=tuple(tuple(values) for values, _ in series),
+                slope_chebyshev=tuple(tuple(slopes) for _, slopes in series),
+                digits=arc.digits,
+            ))
+        return tuple(result)
 
     @cached_property
     def omega(self) -> tuple[sympy.Expr, ...]:
@@ -745,6 +875,11 @@ class Expansion:
         (evenness, 2π-periodicity) and the pieces end at the moving contact
         angles s_i*(ε) = β_i + Σ_{k≤N} σ_{i,k} ε^k, as in :meth:`displacement`.
         """
+        if self._stretched_pieces:
+            raise UnsupportedNonlinearityError(
+                "a stretched contact arc (non-polynomial contact law) has no closed-form displacement: evaluate it with "
+                "Expansion.displacement, or export Expansion.stretched_arcs (Chebyshev coefficients) with to_json"
+            )
         frequency = self.frequency_expr(self.order) + self.omega_next * self.gauge ** (self._steps * self.order + 1)
         strained = frequency * TIME + self.phase_expr()
         if not self.is_piecewise:
@@ -814,7 +949,10 @@ class Expansion:
             for waveform in self.waveforms:
                 lines.append(rf"v_{{{waveform.order}}}(s) &= {waveform.to_latex()}")
         header = f"% lindstedt: {problem.describe()}\n"
-        return header + "\\begin{align*}\n" + " \\\\\n".join(lines) + "\n\\end{align*}\n"
+        body = header + "\\begin{align*}\n" + " \\\\\n".join(lines) + "\n\\end{align*}\n"
+        if waveforms and self.stretched_arcs:  # the arcs' own expansion, in stretched time
+            body += "\n".join(arc.to_latex() for arc in self.stretched_arcs) + "\n"
+        return body
 
     def to_dict(self, *, waveforms: bool = True) -> dict[str, Any]:
         """The documented JSON-ready dictionary (schema ``lindstedt.expansion/1``)."""
@@ -860,6 +998,8 @@ class Expansion:
             data["regime"] = self.regime
             data["validity_exponent"] = str(self.validity_exponent)
             data["contact_angles"] = [sympy.sstr(value) for value in self.contact_angles]
+        if waveforms and self.stretched_arcs:
+            data["stretched_arcs"] = [arc.to_dict() for arc in self.stretched_arcs]
         return data
 
     def to_json(self, *, waveforms: bool = True, indent: int | None = 2) -> str:
