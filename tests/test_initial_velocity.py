@@ -277,9 +277,24 @@ def test_bad_initial_data_are_typed_errors_naming_the_fix(arguments, match):
         lindstedt.expand("u**3", order=1, omega0=1, **arguments)
 
 
-def test_fractional_law_phase_on_its_stretched_arc_is_refused():
-    with pytest.raises(lindstedt.UnsupportedNonlinearityError, match="stretched"):
-        lindstedt.expand("Max(0, u - 1/4)**(3/2)", order=1, u0="3/5", v0="4/5", omega0=1).phase
+@pytest.mark.parametrize(
+    "f, u0, v0",
+    [("Max(0, u - 1/4)**(3/2)", "3/5", "4/5"), ("Max(0, u)**(3/2)", "3/5", "-1/2"), ("Max(0, u - 1/5)*exp(u)", "1/2", "3/5")],
+)
+def test_an_orbit_that_starts_on_a_stretched_contact_arc(f, u0, v0):
+    # u0 inside a Hertz / analytic contact: the phase comes from the arc's fixed-s expansion (numeric)
+    from lindstedt.references import conservative_frequency
+    from lindstedt.validate import fitted_convergence_order
+
+    expansion = lindstedt.expand(f, order=2, u0=u0, v0=v0, omega0=1, precision=20)
+    epsilons = [0.04, 0.02, 0.01]
+    errors = [abs(float(expansion.frequency(e)) - float(conservative_frequency(expansion.problem.nonlinearity, e, a0=u0,
+                                                                                velocity=v0, precision=20)[0]))
+              for e in epsilons]
+    assert np.polyfit(np.log(epsilons), np.log(errors), 1)[0] == pytest.approx(3, abs=0.3)
+    assert float(expansion.displacement(0.0, 0.03)) == pytest.approx(float(sympy.Rational(u0)), abs=5e-6)  # O(ε^3)
+    fit = fitted_convergence_order(expansion, np.geomspace(0.02, 0.08, 4))
+    assert fit.success and fit.slope == pytest.approx(3, abs=0.3)
 
 
 @pytest.mark.parametrize(

@@ -217,8 +217,8 @@ class _TurningPoint:
             raise UnsupportedNonlinearityError(f"the energy of the initial data needs f piecewise polynomial: {error}") from None
         total = sympy.Integer(0)
         for interval in intervals:
-            law = sum((c * u**m for m, c in enumerate(interval.coefficients)), sympy.Integer(0))
-            for coefficient, point, power in getattr(interval, "fractional", ()):  # c·|u − b|^p, b an end of the piece
+            law = sum((c * u**m for m, c in enumerate(interval.coefficients)), interval.analytic)  # analytic part too
+            for coefficient, point, power in interval.fractional:  # c·|u − b|^p, b an end of the piece
                 law += coefficient * ((u - point) if point == interval.lower else (point - u)) ** power
             lower, upper = start, top  # u0 < A0: the integral runs over [u0, A0] ∩ [lower, upper]
             if interval.lower is not None and _decided_sign(interval.lower - start, "a breakpoint against u0") > 0:

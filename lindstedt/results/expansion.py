@@ -221,6 +221,14 @@ class PiecewiseWaveform:
 STRETCHED_TIME = sympy.Symbol("tau", nonnegative=True)
 
 
+def _chebyshev_sum(coefficients: list[Any], x: Any) -> Any:
+    """Σ_k c_k T_k(x) by Clenshaw's recurrence (mpmath numbers)."""
+    later, latest = 0, 0
+    for coefficient in reversed(coefficients[1:]):
+        later, latest = coefficient + 2 * x * later - latest, later
+    return coefficients[0] + x * later - latest
+
+
 @dataclass(frozen=True)
 class StretchedArcSeries(JsonExport):
     """A contact arc with a non-polynomial law (Hertz, analytic), expanded in its own stretched time.
@@ -253,6 +261,29 @@ class StretchedArcSeries(JsonExport):
     chebyshev: tuple[tuple[Any, ...], ...]
     slope_chebyshev: tuple[tuple[Any, ...], ...]
     digits: int
+
+    def fixed_s_derivative(self, strained_time: Any, order: int, times: int) -> Any:
+        """``[ε̂^order] ∂^times/∂s^times`` of the normalised displacement ``sign · Σ_n ε̂^n Y_n(τ(s))`` at an interior s.
+
+        Inside the arc (away from its moving end) the fixed-s expansion exists: it is what the phase
+        of an orbit that starts in contact needs.  Mixed derivatives by ``mpmath.diff`` on the series
+        truncated at ``order`` (exact through ε̂^order), at the arc's working precision.
+        """
+        if order >= len(self.chebyshev):
+            raise OrderError(f"the stretched arc is known through order {len(self.chebyshev) - 1}, not {order}")
+        with mpmath.workdps(self.digits + 15):
+            rows = [[mpmath.mpf(c) for c in row] for row in self.chebyshev[: order + 1]]
+            lengths = [mpmath.mpf(value) for value in self.length[: order + 1]]
+
+            def displacement(s: Any, scaled: Any) -> Any:
+                length = mpmath.polyval(lengths[::-1], scaled)
+                tau = (s if self.side == "release" else mpmath.pi - s) / length
+                x = 2 * (1 - tau) ** (mpmath.mpf(1) / self.denominator) - 1
+                total = mpmath.polyval([_chebyshev_sum(row, x) for row in rows][::-1], scaled)
+                return self.sign * total
+
+            value = mpmath.diff(displacement, (mpmath.mpf(strained_time), 0), (times, order)) / mpmath.factorial(order)
+        return +value
 
     def value(self, tau: float, epsilon: float, omega0: float = 1.0) -> float:
         """Σ_n ε̂^n Y_n(τ) in float arithmetic (the normalised displacement on the arc, before sign · a0)."""
@@ -332,6 +363,7 @@ def _phase_coefficients(expansion: "Expansion", highest: int) -> tuple[sympy.Exp
     a = amplitude if to_field is None else to_field(amplitude)
     cosine, sine = start / a, speed / (omega0 * a)  # cos ψ0, sin ψ0 > 0
     piece = 0
+    arc_derivative: Callable[[int, int], sympy.Expr] | None = None  # v_k^{(m)}(ψ0) when ψ0 is on a stretched arc
     if expansion.is_piecewise:
         for index, boundary in enumerate(expansion._form.boundaries):  # by increasing angle, i.e. decreasing κ
             side = _decided_sign(sympy.simplify(boundary.kappa - cosine), "u0 against a breakpoint")
@@ -342,16 +374,23 @@ def _phase_coefficients(expansion: "Expansion", highest: int) -> tuple[sympy.Exp
         arcs = expansion._form.system.arcs
         last = len(expansion._form.boundaries)
         if (piece == 0 and arcs[0] is not None) or (piece == last and arcs[1] is not None):
-            raise UnsupportedNonlinearityError(
-                f"u(0) = {start} lies on a stretched contact arc (non-polynomial law), whose waveform is computed numerically "
-                "on a stretched interval (no closed-form branch to expand the phase from); start the orbit outside that "
-                "contact (another point u0, v0 of the same orbit), or release it at rest with a0= instead of u0/v0"
-            )
+            # u0 on a stretched contact arc: inside it the fixed-s expansion exists, numerically
+            arc = next(item for item in expansion.stretched_arcs if item.side == ("release" if piece == 0 else "far"))
+            if problem.free_symbols:
+                raise UnsupportedNonlinearityError("an orbit that starts on a stretched contact arc needs numeric omega0 and parameters")
+            with mpmath.workdps(arc.digits + 10):
+                numeric_angle = mpmath.mpf(sympy.N(angle, arc.digits + 10))
+
+            def arc_derivative(k: int, m: int) -> sympy.Expr:
+                scale = amplitude * omega0 ** (-2 * k)  # v_k = a0 ω0^{-2k} [ε̂^k] W
+                return scale * sympy.Float(arc.fixed_s_derivative(numeric_angle, k, m), arc.digits)
     waveforms: dict[int, Any] = {}
     derivatives: dict[tuple[int, int], sympy.Expr] = {}
 
     def derivative(k: int, m: int) -> sympy.Expr:
-        """v_k^{(m)}(ψ0), exact (the branch of the piece containing ψ0 for piecewise f)."""
+        """v_k^{(m)}(ψ0), exact (the branch of the piece containing ψ0 for piecewise f; numeric on a stretched arc)."""
+        if (k, m) not in derivatives and arc_derivative is not None:
+            derivatives[k, m] = arc_derivative(k, m)
         if (k, m) not in derivatives:
             if k not in waveforms:
                 waveforms[k] = expansion.waveform(k)
