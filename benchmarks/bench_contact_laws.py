@@ -540,8 +540,17 @@ def _class_accuracy(row: dict[str, Any], mode: str) -> float | None:
         for k in range(1, ORDER + 1):
             ref = mpmath.mpf(reference["values"][k])
             for r in ok:  # every process gives the same ω_k; take the worst anyway
-                worst = max(worst, float(abs(mpmath.mpf(r["omega"][k]) - ref) / abs(ref)))
+                worst = max(worst, float(abs(mpmath.mpf(r["omega"][k]) - ref) / _scale(reference, k)))
     return worst
+
+
+def _scale(reference: dict[str, Any], k: int) -> Any:
+    """|ref_k|, or the largest |ref_j| when ref_k vanishes to 20 digits of it (ω_1 = 0 by symmetry)."""
+    import mpmath
+
+    largest = max(abs(mpmath.mpf(reference["values"][j])) for j in range(1, ORDER + 1))
+    value = abs(mpmath.mpf(reference["values"][k]))
+    return value if value > largest * mpmath.mpf(10) ** -20 else largest
 
 
 def _reference_relative_estimate(reference: dict[str, Any]) -> float | None:
@@ -550,8 +559,7 @@ def _reference_relative_estimate(reference: dict[str, Any]) -> float | None:
     import mpmath
 
     with mpmath.workdps(EXACT_DPS):
-        return max(float(mpmath.mpf(reference["errors"][k]) / abs(mpmath.mpf(reference["values"][k])))
-                   for k in range(1, ORDER + 1))
+        return max(float(mpmath.mpf(reference["errors"][k]) / _scale(reference, k)) for k in range(1, ORDER + 1))
 
 
 def _time_cell(runs: list[dict[str, Any]]) -> str:
@@ -652,7 +660,8 @@ def _markdown(config, quick, tree, class_rows, hb, series, exact, raw_path, elap
       "timed with `time.perf_counter` around the expansion and forcing `.omega` (imports excluded; nothing "
       f"computed before in that process); the cell gives the median and every run ({config['class_repeats']} "
       f"fresh process(es) per cell). Time limit {CLASS_TIMEOUT:.0f} s per process (interpreter, import and "
-      "expansion), reported as *timeout*. *Accuracy*: max over k = 1…4 of |ω_k − ref_k| / |ref_k|, ref = "
+      "expansion), reported as *timeout*. *Accuracy*: max over k = 1…4 of |ω_k − ref_k| / |ref_k| (a ref_k that vanishes to 20 digits of the largest, "
+      "such as ω_1 of a symmetric law, is compared relative to the largest |ref_j|), ref = "
       f"`lindstedt.references.frequency_taylor_coefficients(f, {ORDER}, a0=a0, omega0=1, precision={REFERENCE_PRECISION})` "
       "(Taylor coefficients of the exact frequency ω(ε) = 2π/T(ε), T by quadrature of the energy integral, "
       "interpolated on Chebyshev points in ε), with the reference's own error estimate (max over k of "
