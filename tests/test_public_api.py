@@ -140,3 +140,13 @@ def test_cli_is_the_console_script_and_the_module_entry():
     assert re.search(r'^lindstedt = "lindstedt\.cli:main"$', pyproject, flags=re.M)
     result = subprocess.run([sys.executable, "-m", "lindstedt", "--version"], capture_output=True, text=True, timeout=120, check=False)
     assert result.returncode == 0 and result.stdout.strip(), result.stderr
+
+
+def test_import_lindstedt_does_not_load_scipy():
+    # scipy (~0.25 s of import) is loaded by the numerical routines that use it, not by `import lindstedt`
+    import subprocess
+    import sys
+
+    code = "import sys, lindstedt; print(sorted(name for name in sys.modules if name.split('.')[0] == 'scipy'))"
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert result.stdout.strip() == "[]"

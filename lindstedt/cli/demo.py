@@ -18,7 +18,6 @@ import time
 import mpmath
 import numpy as np
 import sympy
-from scipy.integrate import solve_ivp
 
 from ..methods.lindstedt_poincare import expand
 from ..references.duffing import duffing_frequency_taylor
@@ -113,6 +112,7 @@ def run_demo(order: int = 8, figure_path: str | None = None) -> str:
             def field(_, state, eps=eps, force=force):
                 return [state[1], -state[0] - eps * force(state[0])]
 
+            from scipy.integrate import solve_ivp  # here, not at module level: import lindstedt stays light
             reference = solve_ivp(field, (0, t[-1]), [1.0, 0.0], method="DOP853", t_eval=t, rtol=1e-12, atol=1e-14).y[0]
             error = float(np.max(np.abs(expansion.displacement(t, eps) - reference)))
             lines.append(f"     f = {text:16s} eps = {eps:<6} max error {error:.2e}   (eps^3 = {eps**3:.1e})")
@@ -125,6 +125,7 @@ def run_demo(order: int = 8, figure_path: str | None = None) -> str:
         def field(_, state):
             return [state[1], -state[0] - eps * max(0.0, state[0] - 1 / 3)]
 
+        from scipy.integrate import solve_ivp  # here, not at module level: import lindstedt stays light
         reference = solve_ivp(field, (0, t[-1]), [1.0, 0.0], method="DOP853", t_eval=t, rtol=1e-12, atol=1e-14).y[0]
         curves = []
         for order in (0, 1, 2):

@@ -51,7 +51,6 @@ from functools import partial
 from typing import Any
 
 import numpy as np
-import scipy.optimize
 
 from .._errors import ProblemError
 from ..problems.system import UnilateralSystem
@@ -541,6 +540,7 @@ def _seed_solve(problem: NNMShooting, path: _Path, value: float, guess: np.ndarr
     if impossible:
         return problem._failure(eps, impossible, label="seed")
     columns = np.r_[np.full(n, problem.position_scale), np.full(n, problem.velocity_scale), problem.period_scale]
+    import scipy.optimize  # here, not at module level: import lindstedt stays light
     solution = scipy.optimize.root(lambda y: _seed_residual(problem, eps, amplitude, y * columns), guess / columns,
                                    method="hybr", options={"xtol": 1e-12})
     unknowns = solution.x * columns

@@ -72,7 +72,6 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Sequence
 
 import numpy as np
-import scipy.linalg
 
 from .._errors import ProblemError
 from ..export.json import JsonExport
@@ -349,6 +348,7 @@ def _refine_symmetric(stiffness_l: np.ndarray, mass_l: np.ndarray, basis: np.nda
         block = rayleigh[np.ix_(group, group)]
         block = block - np.mean(np.diag(block)) * np.eye(len(group), dtype=_LONG)
         scale = float(np.max(np.abs(block))) or 1.0
+        import scipy.linalg  # here, not at module level: import lindstedt stays light
         rotation = scipy.linalg.eigh((block / scale).astype(float))[1].astype(_LONG)
         for _ in range(2):
             rotation = rotation + rotation @ ((np.eye(len(group), dtype=_LONG) - rotation.T @ rotation) / 2)
@@ -467,6 +467,7 @@ class ExactFlow:
             projector_l = np.ones((1, 1), dtype=_LONG)
         elif system.symmetric_coupling:
             stiffness = 0.5 * (stiffness + stiffness.T)
+            import scipy.linalg  # here, not at module level: import lindstedt stays light
             squared, basis = scipy.linalg.eigh(stiffness, system.M)
             refined = _refine_symmetric(stiffness_l, mass_l, basis) if np.min(squared) > 0 else None
             if refined is None:

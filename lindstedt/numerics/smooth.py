@@ -12,7 +12,6 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 import sympy
-from scipy.integrate import solve_ivp
 
 from .._errors import ProblemError
 from .flow import FlowResult, SwitchEvent, _as_time
@@ -127,6 +126,7 @@ def smooth_flow(
             return np.full((times.size, 1), u0), np.full((times.size, 1), v0)
 
         return FlowResult(True, "t_end = 0", "DOP853", 0.0, final[:1], final[1:], (), 0, 0, 1, 0, 0, (), evaluator)
+    from scipy.integrate import solve_ivp  # here, not at module level: import lindstedt stays light
     solution = solve_ivp(
         rhs, (0.0, t_end), [u0, v0], method="DOP853", rtol=rtol, atol=atol, dense_output=True, events=wrapped or None
     )

@@ -15,7 +15,6 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-import scipy.optimize
 
 __all__: list[str] = []
 
@@ -131,6 +130,7 @@ class _Bracket:
         if self.function is None or self.function(self.low) <= 0.0:
             return self.low
         counters.root_solves += 1
+        import scipy.optimize  # here, not at module level: import lindstedt stays light
         return scipy.optimize.brentq(
             self.function, self.low, self.high, xtol=_TINY**0.5 + 1e-3 * _EPS * self.high, rtol=4 * _EPS, maxiter=500
         )

@@ -28,7 +28,6 @@ from typing import Any, Iterable, Mapping, NamedTuple, Sequence
 
 import mpmath
 import numpy as np
-import scipy.linalg
 import sympy
 
 from .._errors import ProblemError
@@ -456,6 +455,7 @@ class UnilateralSystem:
     # ------------------------------------------------------------ quantities
     @cached_property
     def _modes(self) -> Modes:
+        import scipy.linalg  # here, not at module level: import lindstedt stays light
         squared, shapes = scipy.linalg.eigh(self.K, self.M)
         frequencies = np.sqrt(squared)
         shapes = np.array(shapes)

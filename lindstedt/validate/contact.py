@@ -17,7 +17,6 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
-import scipy.optimize
 
 from .._errors import ProblemError
 from ..export.json import JsonExport
@@ -102,6 +101,7 @@ def _band_intervals(times: np.ndarray, values: np.ndarray, low: float, high: flo
         if function is None:
             return float(t0 + (level - u0) / (u1 - u0) * (t1 - t0))
         counter[0] += 1
+        import scipy.optimize  # here, not at module level: import lindstedt stays light
         return float(scipy.optimize.brentq(lambda s: float(function(np.array([s]))[0]) - level, t0, t1,
                                            xtol=4e-16 * max(1.0, abs(t1)), rtol=4 * np.finfo(float).eps))
 

@@ -34,9 +34,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, NamedTuple
 
 import numpy as np
-import scipy.optimize
 import sympy
-from scipy.integrate import solve_ivp
 
 from .._errors import ProblemError, UnsupportedNonlinearityError
 from ..export.json import JsonExport
@@ -314,6 +312,7 @@ def _piecewise_dop853(law: _PiecewiseLaw, omega0: float, epsilon: float, u0: flo
                 event = lambda _t, y, level=law.breakpoints[index]: y[0] - level  # noqa: E731
                 event.terminal, event.direction = True, direction
                 events.append(event)
+        from scipy.integrate import solve_ivp  # here, not at module level: import lindstedt stays light
         solution = solve_ivp(rhs, (t, t_end), [u, v], method="DOP853", rtol=rtol, atol=atol,
                              dense_output=True, events=events or None)
         n_evaluations += int(solution.nfev)
@@ -535,6 +534,7 @@ def exact_period(
                            math.nan, math.nan, counter[0], reference.method, problem=_problem_of(source))
 
     def zero(index: int) -> float:
+        import scipy.optimize  # here, not at module level: import lindstedt stays light
         return float(scipy.optimize.brentq(speed, grid[index], grid[index + 1], xtol=1e-15, rtol=4 * np.finfo(float).eps))
 
     half = zero(int(changes[0]))
