@@ -103,3 +103,24 @@ def test_polynomial_ring_coefficients():
     squared = series * series
     assert squared.coefficient(0) == r**2 * ring.convert(Rational(1, 2)) + ring.convert(Rational(1, 8))
     assert math.isclose(float(ring.to_sympy(squared.coefficient(4))), 1 / 8)
+
+
+def test_long_float_products_are_exact_up_to_one_rounding():
+    # float series of 40+ terms multiply by an exact integer convolution: each coefficient is the exact
+    # sum rounded once, whatever the cancellation (checked against the same sum at 300 digits)
+    import mpmath
+    from sympy import RealField
+
+    domain = RealField(dps=40)
+    with mpmath.workdps(60):
+        first = CosineSeries(domain, {k: domain.dtype((-1) ** k * mpmath.mpf(7) ** k / mpmath.mpf(5) ** k / 3) for k in range(50)})
+        second = CosineSeries(domain, {k: domain.dtype(mpmath.mpf(3) ** -k * (1 + mpmath.mpf(k) / 11)) for k in range(45)})
+    product = first * second
+    with mpmath.workdps(300):
+        exact: dict[int, mpmath.mpf] = {}
+        for m, a in first.coefficients.items():
+            for n, b in second.coefficients.items():
+                for harmonic in (m + n, abs(m - n)):  # cos(ms) cos(ns) = (cos((m+n)s) + cos((m−n)s))/2
+                    exact[harmonic] = exact.get(harmonic, 0) + mpmath.mpf(a) * mpmath.mpf(b) / 2
+        for harmonic, value in exact.items():
+            assert abs(mpmath.mpf(product.coefficient(harmonic)) - value) <= abs(value) * mpmath.mpf(2) ** -(domain.precision - 1)

@@ -617,7 +617,7 @@ class Expansion:
         for which, arc in enumerate(self._form.system.arcs):
             if arc is None:
                 continue
-            lengths = tuple(mpmath.mpf(hierarchy.arc_length(which, n)) for n in range(highest + 1))
+            lengths = tuple(hierarchy.arc_length(which, n) for n in range(highest + 1))  # mpf already: mpmath.mpf() would round to mp.prec
             series = [arc.series(n) for n in range(highest + 1)]
             result.append(StretchedArcSeries(
                 side="release" if which == 0 else "far",
