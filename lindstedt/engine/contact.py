@@ -314,19 +314,18 @@ def _stretched_arcs(problem: Oscillator, w_intervals: list, interval_of: list[in
         if len(fractional) > 1 or (fractional and sympy.simplify(fractional[0][1] - kappa) != 0):
             raise UnsupportedNonlinearityError(f"f = {problem.f}: {supported}")
         coefficient, exponent = (fractional[0][0], fractional[0][2]) if fractional else (sympy.S.Zero, None)
-        polynomial = list(polynomial)
-        if which == 1:  # Y = −W (negated exactly: an mpf negated outside workdps would be rounded to 15 digits)
+        # the rest of the law, polynomial part included, is one analytic expression g(y) for the arc
+        law = analytic + sum((value * _ARC_VARIABLE**power for power, value in enumerate(polynomial)), sympy.S.Zero)
+        if which == 1:  # Y = −W: the law −f̂(−Y), contact point −κ
             coefficient, kappa = -coefficient, -kappa
-            polynomial = [-value if power % 2 == 0 else value for power, value in enumerate(polynomial)]
-            analytic = -analytic.subs(_ARC_VARIABLE, -_ARC_VARIABLE)
-        if analytic.free_symbols - {_ARC_VARIABLE}:
-            raise UnsupportedNonlinearityError(f"f = {problem.f}: {supported} (got the symbols {analytic.free_symbols - {_ARC_VARIABLE}})")
+            law = -law.subs(_ARC_VARIABLE, -_ARC_VARIABLE)
+        if law.free_symbols - {_ARC_VARIABLE}:
+            raise UnsupportedNonlinearityError(f"f = {problem.f}: {supported} (got the symbols {law.free_symbols - {_ARC_VARIABLE}})")
         if analytic != 0:
-            _check_analytic_on_arc(analytic, kappa, problem)
-        polynomial = [number(value) for value in polynomial]
+            _check_analytic_on_arc(law, kappa, problem)
         power = None if exponent is None else Fraction(int(exponent.p), int(exponent.q))
-        arcs.append(StretchedArc(number(kappa), power, number(coefficient), polynomial, field.digits,
-                                 None if analytic == 0 else (analytic, _ARC_VARIABLE)))
+        arcs.append(StretchedArc(number(kappa), power, number(coefficient), field.digits,
+                                 None if law == 0 else (sympy.expand(law), _ARC_VARIABLE)))
     return tuple(arcs)
 
 

@@ -7,8 +7,8 @@ the normalised law is
 
     Ω² W'' + W + ε̂ f̂(W) = 0,   f̂(W) = Σ_m c_m W^m + c (W − κ)^p,   W > κ,
 
-with a rational exponent ``p = q/d > 0`` that is not an integer (Hertz: p = 3/2), plus,
-if the law has one, an analytic part g(W) expanded about Y_0 at every point,
+with a rational exponent ``p = q/d > 0`` that is not an integer (Hertz: p = 3/2), plus
+the rest of the law, polynomial or analytic, g(W) expanded about Y_0 at every point,
 ``[g(Y)]_n = Σ_k g^{(k)}(Y_0)/k! [(Y − Y_0)^k]_n`` (an analytic law alone has d = 1).
 The solution is not analytic at the contact point W = κ (W − κ ~ s* − s, so
 W'' ~ (s* − s)^p), and that point moves with ε̂: Lindstedt coefficients W_n(s) at a
@@ -92,24 +92,22 @@ class StretchedArc:
         p = q/d > 0, not an integer.
     coefficient : number
         c of the fractional term c (Y − κ)^p.
-    polynomial : sequence of numbers
-        c_0, c_1, … of the polynomial part of the law on the arc.
     digits : int
         Decimal digits wanted.
     analytic : (sympy expression, symbol), optional
-        An analytic part g(Y) of the law (``exponent`` may then be None: no fractional term).
+        The rest of the law g(Y), polynomial or analytic (``exponent`` may then be None: no fractional term).
 
     Examples
     --------
     >>> from fractions import Fraction
-    >>> arc = StretchedArc(0, Fraction(3, 2), 1, (), 20)
+    >>> arc = StretchedArc(0, Fraction(3, 2), 1, 20)
     >>> mu_constant, mu_per_h, slope_constant, slope_per_h = arc.response(1)
     >>> arc.fix(1, 0)                       # released at Y(0) = 1 exactly
     >>> arc.mu(1) == mu_constant
     True
     """
 
-    def __init__(self, kappa: Any, exponent: Fraction | None, coefficient: Any, polynomial: Sequence[Any], digits: int,
+    def __init__(self, kappa: Any, exponent: Fraction | None, coefficient: Any, digits: int,
                  analytic: tuple[Any, Any] | None = None):
         if exponent is not None and (exponent <= 0 or exponent.denominator == 1):
             raise ValueError("the stretched arc's power law needs a non-integer exponent p > 0")
@@ -124,7 +122,6 @@ class StretchedArc:
         with mpmath.workdps(self._working):
             self.kappa = mpmath.mpf(kappa)
             self.coefficient = mpmath.mpf(coefficient) if exponent is not None else mpmath.mpf(0)
-            self.polynomial = [mpmath.mpf(value) for value in polynomial]
             self.beta = mpmath.acos(self.kappa)
         self.nodes = _INITIAL_NODES
         self._reset()
@@ -151,7 +148,6 @@ class StretchedArc:
         self._second: list[list[Any]] = [[-beta * beta * c for c in self._cos]]  # Y_n''
         self._ratios: list[list[Any]] = [[]]  # R_n (n ≥ 1)
         self._binomial: list[list[Any]] = [[mpmath.mpf(1)] * M]  # B_n of (1 + Σ R ε̂)^p
-        self._powers: dict[tuple[int, int], list[Any]] = {}
         self._taylor: dict[int, list[Any]] = {}  # g^{(k)}(Y_0)/k! at the nodes
         self._deviation: dict[tuple[int, int], list[Any]] = {}  # [(Y − Y_0)^k]_n at the nodes
         self._mu: list[Any] = [1 / (beta * beta)]
@@ -185,20 +181,6 @@ class StretchedArc:
         return at_nodes, (top - bottom) / 2
 
     # -- the hierarchy ----------------------------------------------------------------------------------
-    def _law_power(self, power: int, order: int) -> list[Any]:
-        """[Y^power]_order at the nodes."""
-        key = (power, order)
-        if key not in self._powers:
-            if power == 1:
-                result = self._values[order]
-            else:
-                result = [mpmath.mpf(0)] * self.nodes
-                for i in range(order + 1):
-                    left, right = self._law_power(power - 1, i), self._values[order - i]
-                    result = [r + x * y for r, x, y in zip(result, left, right)]
-            self._powers[key] = result
-        return self._powers[key]
-
     def _taylor_values(self, k: int) -> list[Any]:
         """g^{(k)}(Y_0)/k! at the nodes (the analytic part of the law)."""
         if k not in self._taylor:
@@ -238,15 +220,6 @@ class StretchedArc:
             for k in range(1, order + 1):
                 term = self._deviation_power(k, order)
                 total = [t + g * x for t, g, x in zip(total, self._taylor_values(k), term)]
-        for power, value in enumerate(self.polynomial):
-            if not value:
-                continue
-            if power == 0:
-                if order == 0:
-                    total = [t + value for t in total]
-                continue
-            term = self._law_power(power, order)
-            total = [t + value * x for t, x in zip(total, term)]
         return total
 
     def _particular(self, order: int) -> dict:

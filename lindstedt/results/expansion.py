@@ -59,6 +59,7 @@ from .._errors import OrderError, ParameterError, UnsupportedNonlinearityError
 from ..algebra.branch import Branch, EvaluationPoint
 from ..problems.oscillator import Oscillator, _decided_sign, reduce_quadratic
 from ..engine.branches import BranchHierarchy, FloatBranches
+from ..engine.stretched import FloatArc
 from ..engine.contact import PiecewiseNormalForm
 from ..engine.smooth import MAX_ORDER, NormalForm, SmoothHierarchy
 
@@ -287,9 +288,9 @@ class StretchedArcSeries(JsonExport):
 
     def value(self, tau: float, epsilon: float, omega0: float = 1.0) -> float:
         """Σ_n ε̂^n Y_n(τ) in float arithmetic (the normalised displacement on the arc, before sign · a0)."""
-        x = 2.0 * (1.0 - tau) ** (1.0 / self.denominator) - 1.0
-        scaled = epsilon / omega0**2
-        return float(sum(scaled**n * np.polynomial.chebyshev.chebval(x, [float(c) for c in row]) for n, row in enumerate(self.chebyshev)))
+        values = [[float(c) for c in row] for row in self.chebyshev]
+        weights = (epsilon / omega0**2) ** np.arange(len(values))
+        return float(FloatArc(self.denominator, values, values).evaluate(np.asarray(tau, dtype=float), weights, False))
 
     def to_latex(self) -> str:
         """The representation on the arc, as a LaTeX sentence."""
