@@ -22,10 +22,6 @@ Examples
 (1, 3/8, -21/256)
 """
 
-from .methods.all_modes import AllModesFirstOrder, all_modes_first_order
-from .methods.lindstedt_poincare import LindstedtPoincare, cache_info, clear_cache, expand
-from .export.codegen import CodeGenerationError, GeneratedCode, generate_code
-from .algebra.cosine import CosineSeries, SineSeries, solve_harmonic_oscillator
 from ._errors import (
     ConvergenceError,
     LindstedtError,
@@ -35,25 +31,51 @@ from ._errors import (
     ResonanceError,
     UnsupportedNonlinearityError,
 )
-from .results.expansion import Expansion, ExpansionValidityWarning, PiecewiseWaveform, Waveform
-from .numerics.flow import ExactFlow
-from .results.nnm import NNMExpansion
-from .problems.nnm import NNMProblem
-from .methods.strained_coordinates import StrainedCoordinatesNNM, nnm
-from .numerics import NNMBranch, NNMResult, continue_nnm, nnm_point, nnm_sweep, seed_example_system
-from .problems.oscillator import Oscillator
-from .problems.system import Modes, UnilateralSystem
-from .validate import (
-    Spectrum,
-    contact_measure,
-    exact_spectrum,
-    expansion_error,
-    expansion_spectrum,
-    fitted_convergence_order,
-    fitted_validity_exponent,
-    reference_solution,
-    spectrum,
-)
+
+# Lazy facade (PEP 562): a public name is imported from its module on first use, so
+# `import lindstedt` (and the CLI's --help) costs the interpreter, not sympy/numpy/mpmath.
+_LAZY = {
+    "methods.all_modes": ("AllModesFirstOrder", "all_modes_first_order"),
+    "methods.lindstedt_poincare": ("LindstedtPoincare", "cache_info", "clear_cache", "expand"),
+    "export.codegen": ("CodeGenerationError", "GeneratedCode", "generate_code"),
+    "algebra.cosine": ("CosineSeries", "SineSeries", "solve_harmonic_oscillator"),
+    "results.expansion": ("Expansion", "ExpansionValidityWarning", "PiecewiseWaveform", "Waveform"),
+    "numerics.flow": ("ExactFlow",),
+    "results.nnm": ("NNMExpansion",),
+    "problems.nnm": ("NNMProblem",),
+    "methods.strained_coordinates": ("StrainedCoordinatesNNM", "nnm"),
+    "numerics": ("NNMBranch", "NNMResult", "continue_nnm", "nnm_point", "nnm_sweep", "seed_example_system"),
+    "problems.oscillator": ("Oscillator",),
+    "problems.system": ("Modes", "UnilateralSystem"),
+    "validate": (
+        "Spectrum",
+        "contact_measure",
+        "exact_spectrum",
+        "expansion_error",
+        "expansion_spectrum",
+        "fitted_convergence_order",
+        "fitted_validity_exponent",
+        "reference_solution",
+        "spectrum",
+    ),
+}
+_MODULE_OF = {name: module for module, names in _LAZY.items() for name in names}
+
+
+def __getattr__(name: str):
+    module = _MODULE_OF.get(name)
+    if module is None:
+        raise AttributeError(f"module 'lindstedt' has no attribute {name!r}")
+    import importlib
+
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value  # later lookups skip __getattr__
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_MODULE_OF))
+
 
 __version__ = "0.1.0"
 

@@ -124,3 +124,43 @@ def test_long_float_products_are_exact_up_to_one_rounding():
                     exact[harmonic] = exact.get(harmonic, 0) + mpmath.mpf(a) * mpmath.mpf(b) / 2
         for harmonic, value in exact.items():
             assert abs(mpmath.mpf(product.coefficient(harmonic)) - value) <= abs(value) * mpmath.mpf(2) ** -(domain.precision - 1)
+
+
+def _product_to_sum(first: dict, second: dict) -> dict:
+    """cos(ms) cos(ns) = (cos((m+n)s) + cos(|m−n|s))/2, summed pairwise in exact Fractions."""
+    from fractions import Fraction
+
+    result: dict[int, Fraction] = {}
+    for m, a in first.items():
+        for n, b in second.items():
+            for harmonic in (m + n, abs(m - n)):
+                result[harmonic] = result.get(harmonic, Fraction(0)) + Fraction(a) * Fraction(b) / 2
+    return {n: value for n, value in result.items() if value}
+
+
+long_rationals = st.dictionaries(
+    st.integers(0, 80),
+    st.fractions(max_denominator=10**30).filter(lambda value: abs(value) < 10**40),
+    min_size=8,
+    max_size=40,
+)
+
+
+@settings(max_examples=60, deadline=None)
+@given(long_rationals, long_rationals, st.sampled_from([None, 0, 1]), st.sampled_from([None, 0, 1]))
+def test_long_rational_products_equal_the_product_to_sum_rule(first, second, first_parity, second_parity):
+    # series of 8+ terms multiply through one packed-integer product; one parity (Duffing's odd
+    # waveforms) is packed at half length: both must equal the pairwise definition exactly
+    def restrict(values, parity):
+        return values if parity is None else {2 * (n // 2) + parity: v for n, v in values.items()}
+
+    first, second = restrict(first, first_parity), restrict(second, second_parity)
+
+    def series(values):
+        return CosineSeries(QQ, {n: QQ(v.numerator, v.denominator) for n, v in values.items()})
+
+    product = series(first) * series(second)
+    expected = _product_to_sum(first, second)
+    assert {n: (int(c.numerator), int(c.denominator)) for n, c in product.coefficients.items()} == {
+        n: (v.numerator, v.denominator) for n, v in expected.items()
+    }

@@ -150,3 +150,21 @@ def test_import_lindstedt_does_not_load_scipy():
     code = "import sys, lindstedt; print(sorted(name for name in sys.modules if name.split('.')[0] == 'scipy'))"
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert result.stdout.strip() == "[]"
+
+
+def test_import_and_help_load_no_numerical_library():
+    # the facade is lazy: `import lindstedt` and `lindstedt --help` load none of sympy, numpy, mpmath,
+    # scipy; the first public name used loads its module (and every public name resolves)
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, contextlib, io, lindstedt, lindstedt.cli\n"
+        "with contextlib.suppress(SystemExit), contextlib.redirect_stdout(io.StringIO()):\n"
+        "    lindstedt.cli.main(['--help'])\n"
+        "heavy = ('sympy', 'numpy', 'mpmath', 'scipy')\n"
+        "print(sorted({name.split('.')[0] for name in sys.modules if name.split('.')[0] in heavy}))\n"
+        "print(all(getattr(lindstedt, name) is not None for name in lindstedt.__all__))\n"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert result.stdout.split("\n")[:2] == ["[]", "True"], result.stdout + result.stderr

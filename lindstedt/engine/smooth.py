@@ -55,7 +55,7 @@ import numpy
 import sympy
 from sympy import QQ, RealField
 
-from ..algebra.cosine import CosineSeries, solve_harmonic_oscillator, sum_series
+from ..algebra.cosine import CosineSeries, solve_harmonic_oscillator, sum_of_products, sum_series
 from .._errors import UnsupportedNonlinearityError
 from ..problems.oscillator import DISPLACEMENT, Oscillator
 from .branches import FloatBranches
@@ -576,9 +576,9 @@ class SmoothHierarchy(LazyOrders):
             return series
         return series.pruned(self.form.prune_tolerance)
 
-    def _multiply(self, left: CosineSeries, right: CosineSeries) -> CosineSeries:
-        self.counters["products"] += 1
-        return self._prune(left * right)
+    def _sum_of_products(self, pairs: list[tuple[CosineSeries, CosineSeries]]) -> CosineSeries:
+        self.counters["products"] += len(pairs)
+        return self._prune(sum_of_products(pairs, self._domain))
 
     def delta_power(self, power: int, order: int) -> CosineSeries:
         """ε̂^order coefficient of δ^power, δ = Σ_{j≥1} ε̂^j w_j."""
@@ -589,12 +589,15 @@ class SmoothHierarchy(LazyOrders):
             result = CosineSeries(self._domain)
         elif power == 1:
             result = self.waveform(order)
+        elif power == 2:  # Σ_{i+j=order} w_i w_j: each unordered pair once, doubled
+            pairs = [(self.waveform(j), self.waveform(order - j)) for j in range(1, (order + 1) // 2)]
+            result = self._sum_of_products(pairs).scale(self._domain.convert(2))
+            if order % 2 == 0:
+                result = self._prune(result + self._sum_of_products([(self.waveform(order // 2),) * 2]))
         else:
-            result = sum_series(
-                (self._multiply(self.waveform(j), self.delta_power(power - 1, order - j)) for j in range(1, order - power + 2)),
-                self._domain,
+            result = self._sum_of_products(
+                [(self.waveform(j), self.delta_power(power - 1, order - j)) for j in range(1, order - power + 2)]
             )
-            result = self._prune(result)
         self._delta_powers[key] = result
         return result
 
@@ -614,9 +617,7 @@ class SmoothHierarchy(LazyOrders):
     def forcing(self, order: int) -> CosineSeries:
         """``F_order``: the ε̂^order coefficient of f̂(w) as a cosine series."""
         if order not in self._forcing:
-            self._forcing[order] = self._prune(
-                sum_series((self._multiply(g, delta) for g, delta in self._taylor_terms(order)), self._domain)
-            )
+            self._forcing[order] = self._sum_of_products(list(self._taylor_terms(order)))
         return self._forcing[order]
 
     def forcing_secular(self, order: int) -> Any:
