@@ -30,6 +30,13 @@ Analytic branches
     :mod:`lindstedt.algebra.branch`): the representation the piecewise engines
     work in; an internal interface, not re-exported here.
 
+The contact field
+    The exact coefficients of those branches for rational or symbolic gaps
+    (module :mod:`lindstedt.algebra.contact_field`): π, the contact angles β_i
+    and their sines σ_i with ``σ_i² + κ_i² = 1`` built in (a polynomial ring
+    modulo ``κ² = 1 − σ²`` or ``(√ℓ)² = ℓ``, localised at monomials in π and σ),
+    canonical and without polynomial gcds; internal, not re-exported here.
+
 Examples
 --------
 >>> import sympy

@@ -9,11 +9,14 @@ state's piece, an *analytic branch*
 which continues analytically past the piece's ends (that is what lets the
 hierarchy expand a contact boundary that moves with ε).  This module gives the
 exact calculus of such branches with coefficients in any sympy domain
-(``QQ``, a fraction field ``QQ(π, β, …)``, ``RealField``):
+(``QQ``, a fraction field ``QQ(π, β, …)``, ``RealField``) or in the
+:class:`~lindstedt.algebra.contact_field.ContactField` (σ² + κ² = 1 built in):
 
 * sums, scalar multiples, derivatives, products (of branches with integer harmonics);
 * evaluation at a point whose ``cos(j s0)``, ``sin(j s0)`` are known
-  (:class:`EvaluationPoint`, using the Chebyshev recurrences from cos s0, sin s0);
+  (:class:`EvaluationPoint`, using the Chebyshev recurrences from cos s0, sin s0),
+  remembered per branch and point (the hierarchy evaluates the derivatives of every
+  lower order at the same contact angles again at each new order);
 * exact antiderivatives (integration by parts, memoised over ``QQ``);
 * the particular solution of ``v'' + v = B`` by undetermined coefficients,
   including the resonant harmonic ``j = 1`` (which raises the power of s).
@@ -201,11 +204,14 @@ class Branch:
     True
     """
 
-    __slots__ = ("domain", "terms")
+    __slots__ = ("domain", "terms", "_values")
 
     def __init__(self, domain: Any, terms: Mapping[TermKey, Any] | None = None):
         self.domain = domain
         self.terms = {key: value for key, value in (terms or {}).items() if value and not (key[0] == 0 and key[1] == 1)}
+        # values at evaluation points, kept with the branch: the hierarchy evaluates the same (memoised)
+        # derivatives of lower orders at the same contact angles at every later order
+        self._values: dict[EvaluationPoint, Any] = {}
 
     @classmethod
     def cosine(cls, domain: Any, harmonic: int = 1, amplitude: Any = None) -> "Branch":
@@ -335,12 +341,16 @@ class Branch:
         return Branch(self.domain, result)
 
     def evaluate(self, point: EvaluationPoint) -> Any:
-        """Exact value at ``point``."""
+        """Exact value at ``point`` (remembered per point: a branch is not changed after construction)."""
+        cached = self._values.get(point)
+        if cached is not None:
+            return cached
         total = self.domain.zero
         for (harmonic, parity, power), value in self.terms.items():
             trig = point.cos_multiple(harmonic) if parity == 0 else point.sin_multiple(harmonic)
             if trig:
                 total = total + value * point.power(power) * trig
+        self._values[point] = total
         return total
 
     def integral(self, lower: EvaluationPoint, upper: EvaluationPoint) -> Any:

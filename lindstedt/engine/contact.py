@@ -10,8 +10,11 @@ consecutive breakpoints.  With ``w = u/a0``, ``ω = ω0 Ω``, ``ε̂ = ε/ω0²`
 whose breakpoints ``κ_i = u_i/a0`` are crossed by ``w_0 = cos s`` at the
 contact angles ``β_i = arccos κ_i`` when |κ_i| < 1.  This module classifies
 the breakpoints against the orbit [−1, 1] (crossing, grazing, never reached,
-permanent contact), chooses the coefficient field (exact ``QQ(π, κ, β, sin β)``
-or a ``RealField`` with guard digits near grazing) and hands the
+permanent contact), chooses the coefficient field — exact: the
+:class:`~lindstedt.algebra.contact_field.ContactField` of π, β_i and
+σ_i = sin β_i with σ_i² + κ_i² = 1 (rational or symbolic gaps), else the general
+``QQ(π, κ, β, sin β, …)`` with independent generators; or a ``RealField`` with
+guard digits near grazing — and hands the
 :class:`~lindstedt.engine.branches.BranchSystem` with N = 1 component to the
 one branch hierarchy (:mod:`lindstedt.engine.branches`), which solves it order
 by order.
@@ -31,11 +34,13 @@ from typing import Any
 import mpmath
 import sympy
 from sympy import QQ, RealField
+from sympy.polys.polyerrors import CoercionFailed
 
 from .._errors import ProblemError, UnsupportedNonlinearityError
 from ..problems.piecewise_linear import decompose_piecewise
 from ..problems.oscillator import DISPLACEMENT, Oscillator
 from ..algebra.branch import EvaluationPoint
+from ..algebra.contact_field import ContactField
 from .branches import BranchHierarchy, BranchSystem, ContactState, MovingBoundary
 from .stretched import StretchedArc
 
@@ -90,17 +95,34 @@ class PiecewiseNormalForm:
 
 
 class _ConstantField:
-    """Chooses the coefficient domain and converts the constants of the problem into it."""
+    """Chooses the coefficient domain and converts the constants of the problem into it.
 
-    def __init__(self, values: list[sympy.Expr], digits: int | None):
+    Exact problems use the :class:`~lindstedt.algebra.contact_field.ContactField` of the crossed
+    breakpoints ``kappas`` (σ² + κ² = 1 holds there, denominators stay monomials in π and σ)
+    whenever it holds every constant (rational or symbolic gaps, rational laws); anything else
+    (an irrational gap, the σ_1 of a crossed grazing point, …) the general
+    ``QQ.frac_field(π, κ…, g…)`` with one independent generator per transcendental atom.
+    """
+
+    def __init__(self, values: list[sympy.Expr], digits: int | None, kappas: tuple[sympy.Expr, ...] = ()):
         self.numeric = digits is not None or any(v.has(sympy.Float) for v in values)
         self.generators: list[tuple[sympy.Symbol, sympy.Expr]] = []
         self._replacement: dict[sympy.Expr, sympy.Symbol] = {}
+        self.contact_field: ContactField | None = None
         if self.numeric:
             self.digits = digits or 30
             self.domain = RealField(dps=self.digits)
             return
         self.digits = None
+        try:
+            field = ContactField.for_constants(kappas, values)
+            for value in values:
+                field.from_sympy(value)
+        except (CoercionFailed, TypeError, ValueError):  # not representable there: the general field is always exact
+            pass
+        else:
+            self.contact_field = self.domain = field
+            return
         pi_generator = sympy.Dummy("pi")
         self._replacement[sympy.pi] = pi_generator
         self.generators.append((pi_generator, sympy.pi))
@@ -126,6 +148,8 @@ class _ConstantField:
         value = sympy.sympify(value, strict=True)
         if self.numeric:
             return self.domain.convert(sympy.N(value, self.digits + 10))
+        if self.contact_field is not None:
+            return self.contact_field.from_sympy(value)
         if value.is_Rational:
             return self.domain.convert(value)
         ratio = sympy.simplify(value / sympy.pi) if value.is_number and value.has(sympy.pi) else None
@@ -381,7 +405,7 @@ def _assemble(
         # (measured: (u - 1/3)_+^2 at 30 digits, ω_6 to 9e-27 relative without this): one guard digit per order
         if any(any(value != 0 for value in w_intervals[index][2][2:]) for index in interval_of):
             digits += order_hint
-    field = _ConstantField(values, digits)
+    field = _ConstantField(values, digits, tuple(crossing_kappas))
     domain = field.domain
     piece_laws = [tuple(field.convert(value) for value in w_intervals[interval_index][2]) for interval_index in interval_of]
     arcs = _stretched_arcs(problem, w_intervals, interval_of, fractional_pieces, crossing_kappas, grazing, field) if fractional_pieces else (None, None)

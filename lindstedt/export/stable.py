@@ -107,6 +107,17 @@ def _gap_parts(expression: sympy.Expr, x: sympy.Symbol) -> Any:
         return None
     numerator, denominator = sympy.fraction(sympy.together(replace(expression)))
     generators = (cosine, sine, angle, pi)
+    # a denominator with factors (1 ± κ)^a (a pole of ω_k at κ = ∓1): 1/(1 ± κ) = (1 ∓ κ)/sqrt(1 − κ²)², so the
+    # denominator becomes c π^m sqrt(1 − κ²)^j as the series below need
+    content, factors = sympy.factor_list(denominator, *generators)
+    denominator = content
+    for factor, power in factors:
+        complement = {cosine + 1: 1 - cosine, cosine - 1: -1 - cosine, 1 - cosine: 1 + cosine}.get(factor)
+        if complement is not None:  # factor · complement = ±(1 − κ²) = sqrt(1 − κ²)²
+            numerator *= complement**power
+            denominator *= sine ** (2 * power)
+        else:
+            denominator *= factor**power
     try:
         top = sympy.Poly(sympy.expand(numerator), *generators, domain="QQ")
         bottom = sympy.Poly(sympy.expand(denominator), *generators, domain="QQ")
