@@ -21,8 +21,11 @@ Nonlinear normal modes by shooting
     (the state transition matrix; :func:`flow_epsilon_derivative` gives
     ``∂(X, X')/∂ε`` by a closed-form Duhamel integral).
     :func:`nnm_point` solves for one orbit (:class:`NNMResult`: frequency,
-    release point, Floquet multipliers), :func:`continue_nnm` follows a branch
-    in ε, the energy or the modal amplitude by pseudo-arclength continuation
+    release point, Floquet multipliers; from the linear mode, the
+    strained-coordinates expansion :func:`lindstedt.nnm`, or by continuation
+    in ε where neither converges), :func:`continue_nnm` follows a branch in ε,
+    the energy or the modal amplitude by pseudo-arclength continuation,
+    crossing internal-resonance tongues by parameter jumps
     (:class:`NNMBranch`, progress reported as :class:`ContinuationProgress`),
     :func:`nnm_sweep` solves independent points; :func:`nnm_energy` is the
     energy that parametrises them and :func:`seed_example_system` the seed's

@@ -3,20 +3,34 @@
 :func:`continue_nnm` follows the NNM of one mode in a parameter λ — ε, the
 energy or the modal amplitude (:mod:`lindstedt.numerics.shooting` gives the
 residual ``G(z; λ) = 0`` in the shooting unknowns z and its exact Jacobian).
-One driver runs every method: it solves the first point from the linear mode,
-then asks the method for the next point, counts rejected steps, reports
-progress (:class:`~lindstedt.numerics.ContinuationProgress`) and assembles the
-:class:`~lindstedt.numerics.NNMBranch` (folds, stability and contact changes).
-The methods (``method=``, a small registry) differ only in how they step:
+One driver runs every method: it solves the first point (Newton from the
+linear mode, then from the strained-coordinates expansion :func:`lindstedt.nnm`,
+then by continuation in ε from where the expansion holds — the route of
+:func:`~lindstedt.numerics.nnm_point`), then asks the method for
+the next point, counts rejected steps, reports progress
+(:class:`~lindstedt.numerics.ContinuationProgress`) and assembles the
+:class:`~lindstedt.numerics.NNMBranch` (folds, stability and contact changes,
+resonance jumps).  The methods (``method=``, a small registry) differ only in
+how they step:
 
 ``"arclength"`` — pseudo-arclength continuation
     Unknowns ``w = (z, λ)``; predictor ``w + h t`` along the unit tangent t, the
     null vector of the exact augmented Jacobian ``[∂G/∂z, ∂G/∂λ]`` oriented as
     the previous one; corrector: Newton on ``[G(w); tᵀ(w − w_k) − h] = 0`` in
-    scaled variables.  Step control on the corrector's iterations and the turn
-    of the tangent; passes folds; the Floquet multipliers of every point give
-    the stability along the branch; the last point is solved at exactly
-    ``λ = stop``.
+    scaled variables.  Step control on the corrector's first correction (the
+    predictor's error), its iterations, contact changes and the turn of the
+    tangent; the Floquet multipliers of every point give the stability along
+    the branch; the last point is solved at exactly ``λ = stop``.
+    Internal resonances: where ``λ_k ≈ n ω`` the branch of mode j meets a
+    resonance tongue of mode k — the arc turns vertical (λ stops advancing)
+    and climbing it stalls the continuation (the 20-dof chain with three
+    springs did so at ε ≈ 0.011 after 330 points).  When the tangent's
+    λ-component collapses, the method *jumps*: it solves at fixed λ further and
+    further beyond (predictor: the last regular tangent) and lands on the first
+    regular point of mode j (``NNMBranch.jumps``).  If no landing succeeds, the turn is a
+    fold of mode j itself and is followed, until the branch leaves mode j.
+    A step that would shrink below ``min_step`` is rescued once by the same
+    jump; the branch never ends without a reason naming where and why.
 ``"natural"`` — natural-parameter continuation
     λ steps with the secant-extrapolated previous solution as guess and Newton
     at fixed λ, the step halved on failure.
@@ -46,7 +60,7 @@ import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterable
 from concurrent.futures import Executor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial
 from typing import Any
 
@@ -60,6 +74,7 @@ from .shooting import (
     _TWO_PI,
     NNMShooting,
     _Amplitude,
+    _ExpansionPredictor,
     _impossible_amplitude,
     _newton,
     nnm_energy,
@@ -118,6 +133,145 @@ def _continuation_setup(system, mode, parameter, epsilon, energy, modal_amplitud
 
 
 # --------------------------------------------------------------------------- #
+# one point, robustly: linear mode, expansion predictor, continuation in ε
+# --------------------------------------------------------------------------- #
+#: scaled arclength steps of the continuation that reaches a hard point (its λ range is scaled to 1)
+_HOMOTOPY_STEP, _HOMOTOPY_MAX_STEP, _HOMOTOPY_POINTS = 0.1, 0.25, 60
+#: the continuation to a hard point starts at the largest ε / 2**k (k = 1 … this) where the expansion holds
+_HOMOTOPY_HALVINGS = 6
+#: a start of that continuation must have a unit tangent with at least this λ-component (not in a turn)
+_HOMOTOPY_START_SLOPE = 0.5
+
+
+def _robust_point(problem: NNMShooting, epsilon: float, amplitude: _Amplitude, options: dict[str, Any], *,
+                  min_mode_share: float | None, guesses: tuple[str, ...] = ("linear", "expansion"),
+                  homotopy: bool = True) -> NNMResult:
+    """The NNM at (ε, amplitude), trying in turn the ``guesses`` and then a continuation in ε.
+
+    ``"linear"``: Newton from the linear mode j (exact at ε = 0); ``"expansion"``:
+    Newton from the strained-coordinates expansion (:func:`lindstedt.nnm`, order 2:
+    ω(ε) and the release state).  If both fail and ``homotopy``, the point is
+    reached by pseudo-arclength continuation in ε (with the resonance jumps of
+    :class:`_Arclength`) from the largest ``ε/2**k`` where the expansion holds and
+    its point converges, else from ε = 0 (the linear mode).  The message says
+    which route succeeded; the iterations and flows of every attempt are counted.
+    """
+    impossible = _impossible_amplitude(problem, epsilon, amplitude)
+    if impossible:
+        return problem._failure(epsilon, impossible)
+    labels = {"linear": "the linear mode", "expansion": "the expansion predictor (lindstedt.nnm, order 2)"}
+    failures: list[str] = []
+    iterations = 0
+    for kind in guesses:
+        if kind == "linear":
+            guess = problem._linear_guess(epsilon, amplitude)
+        else:
+            predictor = _ExpansionPredictor.build(problem, epsilon, amplitude)
+            guess = None if predictor is None else predictor.guess(epsilon)
+            if guess is None:
+                failures.append(f"{labels[kind]}: not available (lindstedt.nnm failed or ω(ε) ≤ 0)")
+                continue
+        result = problem._solve(guess, epsilon, amplitude, min_mode_share=min_mode_share, **options)
+        iterations += result.newton_iterations
+        if result.success and kind == "expansion":
+            result = _minimal_period(problem, result, amplitude, options, min_mode_share)
+            iterations += result.newton_iterations
+        if result.success:
+            note = f"; Newton from {labels[kind]} (before: {'; '.join(failures)})" if failures else ""
+            return replace(result, message=result.message + note, newton_iterations=iterations)
+        failures.append(f"Newton from {labels[kind]}: {result.message}")
+    if homotopy and epsilon != 0.0:
+        result = _homotopy(problem, epsilon, amplitude, options, min_mode_share)
+        iterations += result.newton_iterations
+        if result.success:
+            return replace(result, message=f"{result.message} (before: {'; '.join(failures)})",
+                           newton_iterations=iterations)
+        failures.append(result.message)
+    failed = problem._failure(epsilon, "; ".join(failures), iterations)
+    return replace(failed, flow_evaluations=problem.flow_evaluations)
+
+
+def _minimal_period(problem: NNMShooting, result: NNMResult, amplitude: _Amplitude, options: dict[str, Any],
+                    min_mode_share: float | None) -> NNMResult:
+    """``result``, or — when it is an orbit of period T/m run m times — that orbit re-solved at period T/m.
+
+    The returned ``newton_iterations`` are those of the re-solve only (0 when nothing was re-solved).
+    """
+    multiple = problem.period_multiple(result)
+    if multiple == 1:
+        return replace(result, newton_iterations=0, flow_evaluations=problem.flow_evaluations)
+    guess = problem._join(result.release_position, result.release_velocity, result.period / multiple)
+    again = problem._solve(guess, result.epsilon, amplitude, min_mode_share=min_mode_share, **options)
+    if not again.success:
+        return again
+    return replace(again, message=f"{again.message}; the first solution was this orbit run {multiple} times "
+                   f"(period {result.period:.6g}), re-solved at period T/{multiple}")
+
+
+def _homotopy(problem: NNMShooting, epsilon: float, amplitude: _Amplitude, options: dict[str, Any],
+              min_mode_share: float | None) -> NNMResult:
+    """The NNM at ε by continuation in ε at fixed amplitude, from where the expansion or the linear mode holds.
+
+    Starts: the largest ``ε/2**k`` where the expansion holds and its point
+    converges, provided the branch is not turning there (the λ-component of
+    its unit tangent is at least ``_HOMOTOPY_START_SLOPE``: a start next to an
+    internal resonance would leave no reference for the resonance jumps);
+    else ε = 0, the linear mode (``ε/2**6`` for ``energy_per_epsilon``).
+    """
+    failures: list[str] = []
+    iterations = 0
+    fallback = 0.0 if amplitude.kind != "energy_per_epsilon" else epsilon / 2.0**_HOMOTOPY_HALVINGS
+    starts: list[tuple[float, NNMResult | None]] = []
+    predictor = _ExpansionPredictor.build(problem, epsilon, amplitude) if amplitude.kind != "energy_per_epsilon" else None
+    if predictor is not None:
+        for k in range(1, _HOMOTOPY_HALVINGS + 1):
+            candidate = epsilon / 2.0**k
+            if predictor.valid(candidate):
+                guess = predictor.guess(candidate)
+                if guess is not None:
+                    result = problem._solve(guess, candidate, amplitude, min_mode_share=0.5, **options)
+                    iterations += result.newton_iterations
+                    if result.success:
+                        result = _minimal_period(problem, result, amplitude, options, 0.5)
+                        iterations += result.newton_iterations
+                    if result.success:
+                        starts.append((candidate, result))
+                break
+    starts.append((fallback, None))
+    for start, first in starts:
+        if first is None:
+            impossible = _impossible_amplitude(problem, start, amplitude)
+            if impossible:
+                failures.append(f"no start at ε = {start:g} ({impossible})")
+                continue
+            first = problem._solve(problem._linear_guess(start, amplitude), start, amplitude, min_mode_share=0.5,
+                                   **options)
+            iterations += first.newton_iterations
+            if not first.success:
+                failures.append(f"the start at ε = {start:g} failed: {first.message}")
+                continue
+        stepper = _Arclength(problem, _Path("epsilon", amplitude, None), start, epsilon, step=_HOMOTOPY_STEP,
+                             min_step=None, max_step=_HOMOTOPY_MAX_STEP, max_halvings=12, options=options)
+        stepper.initial = first
+        stepper.minimum_start_slope = _HOMOTOPY_START_SLOPE if start != fallback else None
+        branch = _drive(stepper, start, epsilon, _HOMOTOPY_POINTS, None)
+        iterations += branch.newton_iterations - first.newton_iterations
+        if not branch.success:
+            failures.append(f"from ε = {start:g}: {branch.stop_reason}")
+            continue
+        last = branch.points[-1]
+        route = (f"reached by continuation in ε from {start:g} ({len(branch)} points"
+                 + (f", {len(branch.jumps)} resonance jump(s)" if branch.jumps else "") + ")")
+        if min_mode_share is not None and last.mode_share < min_mode_share:
+            failures.append(f"{route} to a periodic orbit that is not the NNM of mode {problem.mode} "
+                            f"(mode-{problem.mode} share {last.mode_share:.1%} < {min_mode_share:.0%})")
+            continue
+        return replace(last, message=f"{last.message}; {route}", newton_iterations=iterations,
+                       flow_evaluations=problem.flow_evaluations)
+    return problem._failure(epsilon, "continuation in ε: " + "; ".join(failures), iterations)
+
+
+# --------------------------------------------------------------------------- #
 # the entry point
 # --------------------------------------------------------------------------- #
 def continue_nnm(
@@ -154,7 +308,9 @@ def continue_nnm(
         1-based mode number j.
     start, stop : float
         Range of the continuation parameter.  The first point is solved from
-        the linear mode j (exactly the linear mode at ε = 0).
+        the linear mode j (exactly the linear mode at ε = 0), else from the
+        expansion :func:`lindstedt.nnm` (order 2), else by continuation in ε
+        from where the expansion holds (as :func:`nnm_point`).
     parameter : {"epsilon", "energy", "modal_amplitude"}
         What varies.  ``"epsilon"`` needs one amplitude (``energy``,
         ``modal_amplitude`` or ``energy_per_epsilon``, the seed's E = c ε);
@@ -165,9 +321,20 @@ def continue_nnm(
         augmented Jacobian ``[∂G/∂z, ∂G/∂λ]``, oriented as the previous one),
         corrector: Newton on ``[G(w); tᵀ(w − w_k) − h] = 0`` in scaled
         variables (λ by ``|stop − start|``, X by the orbit amplitude, T by the
-        period).  Step control: ×1.5 after ≤ 2 corrector iterations, ×0.6
-        after ≥ 5, halved after a failure or a turn of the tangent by more than
-        ~25°; the last point is solved at exactly ``λ = stop``.
+        period).  Step control: the next step aims at a first corrector
+        correction of 2e-3 (scaled; the factor is kept in [0.5, 2]) or grows
+        ×1.5 after ≤ 2 corrector iterations, ×0.6 after ≥ 5, never growing
+        across a change of the springs touching the orbit, halved after a
+        failure or a turn of the tangent by more than ~25°; the last point is
+        solved at exactly ``λ = stop``.
+        Where the branch turns vertical (its tangent's λ-component falls below
+        half its recent level: an internal-resonance tongue), the method jumps
+        across at fixed λ to the next regular point of mode j (up to 8 landings,
+        distances growing ×1.5 from the recent step's λ-extent, at most a
+        quarter of the range; ``NNMBranch.jumps``); if none lands, the turn is
+        followed as a fold until the branch leaves mode j (its mode-j share of
+        the modal energy falls below half that where the turn began), which
+        ends it with that reason.
         ``"natural"``: parameter steps with the previous solution (secant
         extrapolated) as guess and Newton at fixed λ, halving on failure.
         ``"seed"``: the seed's algorithm — natural continuation in ε with
@@ -232,7 +399,9 @@ class _Attempt:
     ``result`` is the accepted point at parameter ``value`` (None: rejected, for
     ``reason``); ``end`` ends the branch unsuccessfully; ``complete`` marks a
     point solved exactly at ``stop`` that completes the branch whatever the
-    callback answers; ``iterations`` are the corrector iterations spent.
+    callback answers; ``iterations`` are the corrector iterations spent;
+    ``jumped`` marks a point reached by a parameter jump across an internal
+    resonance and ``rejected`` counts the failed landings before it.
     """
 
     iterations: int
@@ -241,6 +410,8 @@ class _Attempt:
     reason: str = ""
     end: str | None = None
     complete: bool = False
+    jumped: bool = False  # the accepted point was reached by a parameter jump (see _Arclength.jump)
+    rejected: int = 0  # failed landings of a jump, counted as rejected steps
 
 
 def _drive(stepper: _Stepper, start: float, stop: float, max_points: int,
@@ -248,6 +419,8 @@ def _drive(stepper: _Stepper, start: float, stop: float, max_points: int,
     """Run one continuation method from ``start`` towards ``stop``: first point, steps, bookkeeping, the branch."""
     started = time.perf_counter()
     problem, path = stepper.problem, stepper.path
+
+    jumps: list[int] = []
 
     def finish(points: list[NNMResult], values: list[float], stop_reason: str, success: bool, rejected: int,
                iterations: int) -> NNMBranch:
@@ -257,13 +430,20 @@ def _drive(stepper: _Stepper, start: float, stop: float, max_points: int,
             points=tuple(points), parameter_values=np.array(values, dtype=float), folds=folds,
             stability_changes=stability, contact_changes=contact, flow_evaluations=problem.flow_evaluations,
             newton_iterations=iterations, rejected_steps=rejected, wall_time=time.perf_counter() - started,
-            system=problem.system,
+            system=problem.system, jumps=tuple(jumps),
         )
 
     def notify(index: int, value: float, result: NNMResult) -> bool:
         if callback is None:
             return False
         return bool(callback(ContinuationProgress(index, value, result, stepper.step, problem.flow_evaluations)))
+
+    def reached() -> str:
+        if not jumps:
+            return f"reached stop = {stop:g}"
+        where = ", ".join(f"{values[k]:.4g}–{values[k + 1]:.4g}" for k in jumps)
+        return (f"reached stop = {stop:g}; {len(jumps)} turn(s) of the branch (internal-resonance tongues) crossed "
+                f"by parameter jumps ({stepper.label} in {where}; NNMBranch.jumps)")
 
     first = stepper.first(start)
     if not first.success:
@@ -277,10 +457,11 @@ def _drive(stepper: _Stepper, start: float, stop: float, max_points: int,
         return finish(points, values, failure, False, 0, iterations)
     while True:
         if len(points) >= max_points:
-            return finish(points, values, f"max_points = {max_points} reached at {stepper.label} = {values[-1]:.6g}",
-                          False, rejected, iterations)
+            return finish(points, values, f"max_points = {max_points} reached at {stepper.label} = {values[-1]:.6g}"
+                          + stepper.note(), False, rejected, iterations)
         attempt = stepper.advance(points, values)
         iterations += attempt.iterations
+        rejected += attempt.rejected
         if attempt.end is not None:
             return finish(points, values, attempt.end, False, rejected, iterations)
         if attempt.result is None:
@@ -289,11 +470,13 @@ def _drive(stepper: _Stepper, start: float, stop: float, max_points: int,
             if failure:
                 return finish(points, values, failure, False, rejected, iterations)
             continue
+        if attempt.jumped:
+            jumps.append(len(points) - 1)
         points.append(attempt.result)
         values.append(attempt.value)
         requested = notify(len(points) - 1, attempt.value, attempt.result)
         if attempt.complete or (not requested and attempt.value == stop):
-            return finish(points, values, f"reached stop = {stop:g}", True, rejected, iterations)
+            return finish(points, values, reached(), True, rejected, iterations)
         if requested:
             return finish(points, values, "callback requested stop", False, rejected, iterations)
         stepper.accept(attempt)
@@ -329,17 +512,22 @@ class _Stepper(ABC):
         """The initial step when none is given: 1/50 of the parameter range."""
         return self.span / 50.0
 
+    #: a first point solved beforehand (the continuation of :func:`_robust_point`), or None
+    initial: NNMResult | None = None
+
     def first(self, value: float) -> NNMResult:
-        """The first point, solved from the linear mode."""
-        problem = self.problem
+        """The first point: Newton from the linear mode, then from the expansion, then by continuation in ε."""
+        if self.initial is not None:
+            return self.initial
         eps, amplitude = self.path.at(value)
-        impossible = _impossible_amplitude(problem, eps, amplitude)
-        if impossible:
-            return problem._failure(eps, impossible)
-        return problem._solve(problem._linear_guess(eps, amplitude), eps, amplitude, min_mode_share=0.5, **self.options)
+        return _robust_point(self.problem, eps, amplitude, self.options, min_mode_share=0.5)
 
     def begin(self, first: NNMResult, value: float) -> str | None:
         return None
+
+    def note(self) -> str:
+        """What the stop reasons of the driver should add about the state of the method ("" or "; …")."""
+        return ""
 
     @abstractmethod
     def advance(self, points: list[NNMResult], values: list[float]) -> _Attempt:
@@ -405,10 +593,53 @@ def _unknowns_of(problem: NNMShooting, result: NNMResult) -> np.ndarray:
 # --------------------------------------------------------------------------- #
 # pseudo-arclength continuation
 # --------------------------------------------------------------------------- #
+#: the branch is "turning vertical" when the λ-component of its unit tangent falls below this share of its recent level
+_VERTICAL_RATIO = 0.5
+#: below this recent level of the λ-component the branch is not regular enough to judge a turn
+_REGULAR_MIN = 0.05
+#: accepted points whose tangent's λ-component over the reference is at least this are "regular" (jump bases)
+_REGULAR_RATIO = 0.7
+#: a parameter jump tries these many distances, growing from the typical λ-extent of a regular step
+_JUMP_TRIES = 8
+#: the growth of the jump distance from one landing attempt to the next
+_JUMP_GROWTH = 1.5
+#: a landing point is regular when its tangent's λ-component is at least this share of the reference
+_LANDING_RATIO = 0.5
+#: the scaled first correction of the corrector aimed at by the step control (the predictor's error)
+_PREDICTOR_ERROR = 2e-3
+#: the longest jump, as a fraction of the range |stop − start|
+_JUMP_MAX_FRACTION = 0.25
+#: the landing point of a jump must carry at least min(this, _RELATIVE_MODE_SHARE × the base point's share) of
+#: the modal energy in mode j (the NNM of mode j, not an orbit of the resonant mode)
+_JUMP_MODE_SHARE = 0.5
+#: followed through a turn (no jump landed), the branch ends when its mode-j share falls below this fraction of
+#: the share where the turn began: it has become an orbit of other modes
+_RELATIVE_MODE_SHARE = 0.5
+
+
 class _Arclength(_Stepper):
-    """Predictor along the tangent of the branch, corrector with the arclength constraint, adaptive step."""
+    """Predictor along the tangent of the branch, corrector with the arclength constraint, adaptive step.
+
+    Internal resonances.  Where ``λ_k ≈ n ω`` for another mode k, the branch of
+    mode j meets a resonance tongue: the arc bends, its tangent turns towards
+    mode k and the parameter stops advancing (the tongue grows mode k at almost
+    constant λ, without bound for these piecewise-linear systems, or closes on
+    itself).  Followed faithfully, pseudo-arclength climbs the tongue and the
+    parameter stalls.  So when the λ-component of the unit tangent falls below
+    ``_VERTICAL_RATIO`` of its recent level (or the tangent turns too much and
+    it falls below ``_REGULAR_RATIO``), the step is not taken: :meth:`jump`
+    solves at fixed λ beyond it (distances growing ×``_JUMP_GROWTH`` from the
+    λ-extent of the recent steps, at most ``_JUMP_MAX_FRACTION`` of the range;
+    predictor: the last regular tangent) and lands on the first point of mode j
+    whose own tangent is regular again.  If no landing succeeds the turn is a fold of mode j and
+    is followed (pseudo-arclength as before) until the branch is regular again
+    or leaves mode j, which ends it with the reason.  The same jump rescues,
+    once, a step that would shrink below ``min_step``.
+    """
 
     name = "arclength"
+    #: reject a first point whose tangent's λ-component is below this (None: no check)
+    minimum_start_slope: float | None = None
 
     def default_step(self) -> float:
         """The initial step when none is given: 1/50 in scaled arclength (λ is scaled by the range)."""
@@ -436,6 +667,40 @@ class _Arclength(_Stepper):
             vector = -vector
         return vector / np.linalg.norm(vector)
 
+    # ------------------------------------------------------------ the branch's shape
+    def slope(self, tangent: np.ndarray) -> float:
+        """The λ-component of a unit tangent, positive towards ``stop``."""
+        return self.direction * float(tangent[-1])
+
+    def reference(self) -> float | None:
+        """The recent level of the tangent's λ-component (median of the last regular points), None if too small."""
+        if not self.slopes:
+            return None
+        level = float(np.median(self.slopes[-5:]))
+        return level if level > _REGULAR_MIN else None
+
+    def other_mode(self, tangent: np.ndarray, scales: np.ndarray) -> int | None:
+        """The mode (1-based) dominating the tangent's change of state when it is not mode j, else None."""
+        problem = self.problem
+        x, v, _ = problem.split(tangent[:-1] * scales[:-1])
+        frequencies = problem.system.modes().frequencies
+        energy = (frequencies * (problem.projector @ x)) ** 2 + (problem.projector @ v) ** 2
+        total = float(np.sum(energy))
+        if not total > 0 or energy[problem.mode - 1] >= 0.5 * total:
+            return None
+        return int(np.argmax(energy)) + 1
+
+    def resonance(self, mode: int | None, result: NNMResult) -> str:
+        """Words for the vertical turn of the branch at ``result``, its tangent mostly ``mode`` (None: mode j)."""
+        if mode is None:
+            return "the branch turns vertical (a fold)"
+        lam = float(self.problem.system.modes().frequencies[mode - 1])
+        harmonic = max(1, round(lam / result.frequency))
+        if abs(lam / result.frequency - harmonic) > 0.1:
+            return f"the branch turns vertical towards mode {mode} (λ_{mode} = {lam:.6g}, ω = {result.frequency:.6g})"
+        return (f"the branch turns vertical towards mode {mode}: internal resonance λ_{mode} = {lam:.6g} ≈ "
+                f"{harmonic} ω (ω = {result.frequency:.6g})")
+
     def begin(self, first: NNMResult, value: float) -> str | None:
         self.w = np.r_[_unknowns_of(self.problem, first), value]
         self.scales = self.scales_at(first, value)
@@ -443,9 +708,27 @@ class _Arclength(_Stepper):
         if not out["success"]:
             return f"tangent failed: {out['message']}"
         self.tangent = self.tangent_of(out["augmented"], self.scales, None)
+        if self.minimum_start_slope is not None and self.slope(self.tangent) < self.minimum_start_slope:
+            return (f"the first point at {self.label} = {value:.6g} lies in a turn of the branch (λ-component of the "
+                    f"unit tangent {self.slope(self.tangent):.3f} < {self.minimum_start_slope:g})")
+        self.last = first
+        self.last_regular_share = first.mode_share
+        self.slopes: list[float] = []
+        self.extents: list[float] = []
+        self.regular = (self.tangent, self.scales, self.step)
+        self.rescue: str | None = None
+        self.rescued = False
+        self.following: str | None = None  # why the branch is followed through a turn (jumps failed there)
         return None
 
+    def note(self) -> str:
+        return f"; {self.following}" if self.following else ""
+
+    # ------------------------------------------------------------ one step
     def advance(self, points: list[NNMResult], values: list[float]) -> _Attempt:
+        if self.rescue is not None:  # the step collapsed: step across instead of shrinking to nothing
+            reason, self.rescue = self.rescue, None
+            return self.jump(0, reason, collapse=True)
         problem, path, options = self.problem, self.path, self.options
         w, scales, tangent, h = self.w, self.scales, self.tangent, self.step
         direction, start, stop = self.direction, self.start, self.stop
@@ -466,9 +749,9 @@ class _Arclength(_Stepper):
             return _Attempt(iterations, reason=outcome.message)
         candidate = outcome.unknowns
         value = float(candidate[-1])
-        if direction * (value - start) < 0:
-            return _Attempt(iterations, value, end=f"the branch turned back past start = {start:g} (folds of the "
-                            f"branch in {path.parameter}; see NNMBranch.folds)")
+        if direction * (value - start) < 0:  # a step too long for the curvature, or a fold: retry shorter
+            return _Attempt(iterations, value, reason=f"the corrector returned behind start = {start:g} "
+                            f"({path.parameter} = {value:.6g}): the branch folds back there or the step is too long")
         if direction * (value - stop) >= 0:  # crossed stop: land exactly on it, from the interpolated guess
             fraction = (stop - values[-1]) / (value - values[-1])
             guess = w[:-1] + fraction * (candidate[:-1] - w[:-1])
@@ -483,30 +766,158 @@ class _Arclength(_Stepper):
                                 amplitude=amplitude)
         if not result.success:
             return _Attempt(iterations, value, reason=result.message)
+        floor = _RELATIVE_MODE_SHARE * self.last_regular_share
+        if self.following and result.mode_share < floor:
+            return _Attempt(iterations, value, end=(
+                f"{self.following}, and it leaves mode {problem.mode} at {self.label} = {value:.6g} "
+                f"(mode-{problem.mode} share {result.mode_share:.1%}, below half its {self.last_regular_share:.1%} "
+                f"where the turn began)"))
         # tangent at the new point from the corrector's last Jacobian (no extra flow)
         new_scales = self.scales_at(result, value)
         previous = tangent * scales / new_scales
         previous /= np.linalg.norm(previous)
         new_tangent = self.tangent_of(outcome.last["augmented"], new_scales, previous)
+        reference, slope = self.reference(), self.slope(new_tangent)
         turn = float(new_tangent @ previous)
-        if not (turn >= 0.9 or h <= self.h_min):
-            return _Attempt(iterations, value, reason=f"the tangent turned too much (cos = {turn:.3f})")
-        self.pending = (candidate, new_scales, new_tangent, outcome.iterations)
-        return _Attempt(iterations, value, result)
+        turned = not (turn >= 0.9 or h <= self.h_min)
+        vertical = reference is not None and (slope < _VERTICAL_RATIO * reference
+                                              or (turned and slope < _REGULAR_RATIO * reference))
+        if vertical and not self.following:
+            # the branch turns vertical: a resonance tongue ahead — do not climb it, step across (if that fails,
+            # it is a fold of mode j: follow it)
+            self.scales_at(self.last, values[-1])  # the residual scaling of the base point
+            jump = self.jump(iterations, self.resonance(self.other_mode(new_tangent, new_scales), result),
+                             extent=abs(value - values[-1]))
+            if jump.end is None:
+                return jump
+            self.following = (f"{jump.end}; the branch is followed through the turn from {self.label} = "
+                              f"{values[-1]:.6g}")
+            self.scales_at(result, value)
+            iterations, rejected = jump.iterations, jump.rejected
+        else:
+            rejected = 0
+        if turned:
+            return _Attempt(iterations, value, reason=f"the tangent turned too much (cos = {turn:.3f})",
+                            rejected=rejected)
+        self.pending = (candidate, new_scales, new_tangent, outcome, result, abs(value - values[-1]))
+        return _Attempt(iterations, value, result, rejected=rejected)
 
     def reject(self, attempt: _Attempt, values: list[float]) -> str | None:
         self.step *= 0.5
         if self.step < self.h_min:
+            if not self.rescued:  # one rescue per collapse: a parameter jump from the last point
+                self.rescued = True
+                self.rescue = (f"step size {self.step:.2e} below min_step {self.h_min:.2e} at {self.path.parameter} = "
+                               f"{values[-1]:.6g}: {attempt.reason}")
+                return None
             return (f"step size {self.step:.2e} below min_step {self.h_min:.2e} at {self.path.parameter} = "
                     f"{values[-1]:.6g}: {attempt.reason}")
         return None
 
     def accept(self, attempt: _Attempt) -> None:
-        self.w, self.scales, self.tangent, corrector_iterations = self.pending
-        if corrector_iterations <= 2:
-            self.step = min(1.5 * self.step, self.h_max)
-        elif corrector_iterations >= 5:
-            self.step = max(0.6 * self.step, self.h_min)
+        candidate, scales, tangent, outcome, result, extent = self.pending
+        contact_changed = result.contact_springs != self.last.contact_springs
+        self.w, self.scales, self.tangent, self.last = candidate, scales, tangent, result
+        self.rescued = False
+        slope = self.slope(tangent)
+        reference = self.reference()
+        if not attempt.jumped:
+            self.extents.append(extent)
+        if reference is None or slope >= _REGULAR_RATIO * reference:
+            self.slopes.append(slope)
+            self.regular = (tangent, scales, self.step)
+            self.last_regular_share = result.mode_share
+            self.following = None
+        if attempt.jumped:
+            return  # the step was reset by the jump
+        self.step = min(max(self.step * self.step_factor(outcome, contact_changed), self.h_min), self.h_max)
+
+    def step_factor(self, outcome: Any, contact_changed: bool) -> float:
+        """Factor of the next step from the corrector: its first correction (the predictor's error, O(h²)) and
+        its iterations; never growing across a contact change (the residual is not smooth there).
+
+        The error factor ``sqrt(_PREDICTOR_ERROR / first correction)`` (kept in [0.5, 2]) and the iteration
+        factor (×1.5 after ≤ 2 iterations) each may grow the step; ≥ 5 iterations shrink it (×0.6 at least).
+        """
+        iterations, steps = outcome.iterations, outcome.steps
+        error = min(max(math.sqrt(_PREDICTOR_ERROR / steps[0]), 0.5), 2.0) if steps and steps[0] > 0 else 2.0
+        if iterations >= 5:
+            return min(error, 0.6)
+        factor = max(error, 1.5 if iterations <= 2 else 1.0)
+        if iterations >= 4:
+            factor = min(factor, 1.0)
+        return min(factor, 1.0) if contact_changed else factor
+
+    # ------------------------------------------------------------ parameter jumps
+    def jump(self, iterations: int, why: str, collapse: bool = False, extent: float = 0.0) -> _Attempt:
+        """Solve at fixed λ beyond the last point, further and further, until a regular point of mode j is found.
+
+        The distances grow ×``_JUMP_GROWTH`` from ``extent`` or the typical
+        λ-extent of the recent steps, whichever is larger, up to
+        ``_JUMP_MAX_FRACTION`` of the range.  The landing must verify, carry
+        mode j (share ≥ min(``_JUMP_MODE_SHARE``, ``_RELATIVE_MODE_SHARE`` × the
+        base point's)) and have a regular tangent; a landing at ``stop`` only
+        needs the first two.  Returns the accepted landing or the reason none
+        succeeded (``end``).
+        """
+        problem, options = self.problem, self.options
+        base, base_scales = self.w, self.scales
+        value0 = float(base[-1])
+        tangent, scales, step = self.regular
+        direction_vector = tangent * scales  # unscaled
+        extent = max(extent, float(np.median(self.extents[-5:])) if self.extents else 0.0)
+        if not extent > 0:
+            extent = abs(step * tangent[-1] * scales[-1]) or self.span / 50.0
+        reference = self.reference()
+        rejected, last_reason = 0, "no landing tried"
+        longest = max(extent, _JUMP_MAX_FRACTION * self.span)
+        distance = 0.0
+        for attempt in range(_JUMP_TRIES):
+            previous, distance = distance, min(extent * _JUMP_GROWTH**attempt, longest)
+            if distance == previous:
+                break  # capped: the same distance again would land on the same point
+            target = value0 + self.direction * distance
+            final = self.direction * (target - self.stop) >= 0
+            if final:
+                target = self.stop
+            if not abs(direction_vector[-1]) > 0:
+                break
+            guess = base[:-1] + (target - value0) / direction_vector[-1] * direction_vector[:-1]
+            eps, amplitude = self.path.at(target)
+            outcome = _newton(lambda z, target=target: self.augmented(np.r_[z, target]), guess, base_scales[:-1],
+                              tol=options["tol"], max_iterations=options["max_iterations"])
+            iterations += outcome.iterations
+            if not outcome.success:
+                rejected, last_reason = rejected + 1, outcome.message
+                continue
+            result = problem.verify(outcome.unknowns, eps, verify_tol=options["verify_tol"],
+                                    stability_tol=options["stability_tol"], iterations=outcome.iterations,
+                                    amplitude=amplitude,
+                                    min_mode_share=min(_JUMP_MODE_SHARE, _RELATIVE_MODE_SHARE * self.last.mode_share))
+            if not result.success:
+                rejected, last_reason = rejected + 1, result.message
+                self.scales_at(self.last, value0)
+                continue
+            if final:
+                return _Attempt(iterations, target, result, complete=True, jumped=True, rejected=rejected)
+            new_scales = self.scales_at(result, target)
+            new_tangent = self.tangent_of(outcome.last["augmented"], new_scales, None)
+            slope = self.slope(new_tangent)
+            if reference is None or slope >= _LANDING_RATIO * reference:
+                self.pending = (np.r_[outcome.unknowns, target], new_scales, new_tangent, outcome, result,
+                                abs(target - value0))
+                self.step = step
+                return _Attempt(iterations, target, result, jumped=True, rejected=rejected)
+            rejected += 1
+            last_reason = (f"landed at {self.label} = {target:.6g} in a turn of the branch again "
+                           f"({self.resonance(self.other_mode(new_tangent, new_scales), result)})")
+            self.scales_at(self.last, value0)
+        where = f"{self.label} ≈ {value0:.6g}"
+        if collapse:
+            return _Attempt(iterations, end=f"{why}; no parameter jump beyond {where} converged to the NNM of mode "
+                            f"{problem.mode} (last: {last_reason})", rejected=rejected)
+        return _Attempt(iterations, end=f"at {where} {why}; no parameter jump up to {distance:.3g} beyond it landed "
+                        f"on a regular point of the NNM of mode {problem.mode} (last: {last_reason})", rejected=rejected)
 
 
 # --------------------------------------------------------------------------- #

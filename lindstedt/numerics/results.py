@@ -84,6 +84,12 @@ class NNMResult(JsonExport):
         The 2N × 2N monodromy matrix.
     system : UnilateralSystem
         The system the orbit belongs to (kept, not written into ``nnm-numeric/1``).
+    contact_springs : tuple of int
+        The springs (rows of ``A``) that switch along the orbit, increasing
+        (not written into ``nnm-numeric/1``); a spring engaged or free during
+        the whole orbit is not listed.  A change between two points of a branch
+        is a spring whose gap ``A_i X − b_i`` starts or stops changing sign
+        along the orbit: it grazes the orbit's turning point in between.
 
     JSON schema ``lindstedt.nnm-numeric/1`` (:meth:`to_dict`, documented key by key).
     """
@@ -111,6 +117,7 @@ class NNMResult(JsonExport):
     flow_evaluations: int
     monodromy: np.ndarray | None = field(default=None, repr=False)
     system: Any = field(default=None, repr=False, compare=False)  # the UnilateralSystem it was computed for
+    contact_springs: tuple[int, ...] = field(default=(), compare=False)
 
     @property
     def contact(self) -> bool:
@@ -232,17 +239,26 @@ class NNMBranch(JsonExport):
     stability_changes : tuple of int
         Indices k such that stability differs between points k and k + 1.
     contact_changes : tuple of int
-        Indices k such that contact (switches per period > 0) differs between points k and k + 1.
+        Indices k such that contact (switches per period > 0) or the springs
+        switching along the orbit (:attr:`NNMResult.contact_springs`) differ
+        between points k and k + 1: a spring grazes the orbit in between.
     flow_evaluations : int
         Total flow integrations (including rejected steps and verifications).
     newton_iterations : int
         Total corrector iterations (Newton or hybr).
     rejected_steps : int
-        Steps that failed and were retried with a smaller step.
+        Steps that failed and were retried with a smaller step, and failed
+        landings of parameter jumps.
     wall_time : float
+        Seconds.
     system : UnilateralSystem
         The system of the branch (exported as its JSON dictionary).
-        Seconds.
+    jumps : tuple of int
+        Indices k such that points k and k + 1 are joined by a parameter jump
+        across an internal resonance (method "arclength": the branch of mode j
+        turns there into a resonance tongue of another mode, which is not
+        followed; see :func:`~lindstedt.numerics.continue_nnm`), not by a
+        continuous arc.
 
     JSON schema ``lindstedt.nnm-branch/1`` (:meth:`to_json`; every point as
     its ``lindstedt.nnm-numeric/1`` dictionary).
@@ -264,6 +280,7 @@ class NNMBranch(JsonExport):
     rejected_steps: int
     wall_time: float
     system: Any = field(default=None, repr=False, compare=False)  # the UnilateralSystem it was computed for
+    jumps: tuple[int, ...] = ()
 
     def __len__(self) -> int:
         return len(self.points)
@@ -290,10 +307,14 @@ class NNMBranch(JsonExport):
 
 
 def _branch_events(points: Sequence[NNMResult], values: Sequence[float]) -> tuple[tuple[int, ...], ...]:
-    """Folds (the parameter turns back at point k), stability and contact changes (between points k and k + 1)."""
+    """Folds (the parameter turns back at point k), stability and contact changes (between points k and k + 1).
+
+    A contact change is a change of the springs switching along the orbit (a spring grazing in between).
+    """
     increments = np.diff(np.asarray(values, dtype=float))
     folds = tuple(int(k) + 1 for k in np.flatnonzero(increments[:-1] * increments[1:] < 0))
     pairs = list(zip(points[:-1], points[1:]))
     stability = tuple(k for k, (a, b) in enumerate(pairs) if a.stable != b.stable)
-    contact = tuple(k for k, (a, b) in enumerate(pairs) if a.contact != b.contact)
+    contact = tuple(k for k, (a, b) in enumerate(pairs)
+                    if a.contact != b.contact or a.contact_springs != b.contact_springs)
     return folds, stability, contact

@@ -53,6 +53,7 @@ class _Trajectory:
     sensitivity: np.ndarray | None  # ∂(X, V)(t) / ∂(X0, V0)
     d_epsilon: np.ndarray | None  # ∂(X, V)(t) / ∂ε
     n_switches: int
+    springs: tuple[int, ...] = ()  # the springs that switch on [0, t], increasing
 
 
 def _duhamel_kernels(omega_k: np.ndarray, omega_m: np.ndarray, tau: float) -> tuple[np.ndarray, ...]:
@@ -122,7 +123,9 @@ def _integrate(
             eta = constant * np.sin(omega * tau) / omega + np.sum(cos_amplitude * cos_rate + sin_amplitude * sin_rate, axis=1)
             z = z + np.concatenate([P @ zeta, P @ eta])
         derivative = z
-    return _Trajectory(True, "", run["x"], run["v"], run["jacobian"] if sensitivity else None, derivative, len(run["events"]))
+    springs = tuple(sorted({event.spring for event in run["events"]}))
+    return _Trajectory(True, "", run["x"], run["v"], run["jacobian"] if sensitivity else None, derivative,
+                       len(run["events"]), springs)
 
 
 def flow_epsilon_derivative(

@@ -77,6 +77,8 @@ Examples
 from __future__ import annotations
 
 import math
+import threading
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -260,6 +262,7 @@ class NNMShooting:
         self.projector = shapes.T @ system.M  # u = Φᵀ M X
         self.n_unknowns = self.n + 1 if formulation == "symmetric" else 2 * self.n + 1
         self._flows: dict[float, ExactFlow] = {}
+        self._expansions: dict[tuple[str, float], Any] = {}  # lindstedt.nnm per (amplitude kind, a0)
         self.flow_evaluations = 0
         self.set_scales(epsilon=0.0)
 
@@ -488,7 +491,31 @@ class NNMShooting:
             floquet_multipliers=multipliers, stable=stable, residual=residual, n_switches=trajectory.n_switches,
             mode_share=share, formulation=label, newton_iterations=iterations,
             flow_evaluations=self.flow_evaluations, monodromy=monodromy, system=self.system,
+            contact_springs=trajectory.springs,
         )
+
+    def period_multiple(self, result: NNMResult, *, largest: int = 6, tol: float = 1e-6) -> int:
+        """The m ≤ ``largest`` such that the verified orbit ``result`` is an orbit of period T/m run m times (else 1).
+
+        Newton from a distant guess (an expansion far beyond its validity) can converge to a true periodic
+        orbit with its period multiplied: the shooting equations hold for it too.  One dense flow over T,
+        the state at T/m compared with the release state (relative ``tol``).
+        """
+        if not (result.success and result.period > 0):
+            return 1
+        self.flow_evaluations += 1
+        trajectory = self._flow(result.epsilon).solve(result.release_position, result.release_velocity, result.period)
+        if not trajectory.success:
+            return 1
+        scale = max(float(np.max(np.abs(result.release_position))),
+                    float(np.max(np.abs(result.release_velocity))) / result.frequency, np.finfo(float).tiny)
+        for m in range(largest, 1, -1):  # the largest m first: the shortest period found wins
+            x, v = trajectory.state(result.period / m)
+            error = max(float(np.max(np.abs(x - result.release_position))),
+                        float(np.max(np.abs(v - result.release_velocity))) / result.frequency) / scale
+            if error <= tol:
+                return m
+        return 1
 
     def _failure(self, epsilon: float, message: str, iterations: int = 0, *, label: str | None = None,
                  x0: np.ndarray | None = None) -> NNMResult:
@@ -529,6 +556,8 @@ class _NewtonOutcome:
     unknowns: np.ndarray
     iterations: int
     last: dict[str, Any] | None = None
+    #: scaled sizes max|Δ/columns| of the full Newton steps, in order (their ratios are the contraction)
+    steps: tuple[float, ...] = ()
 
 
 def _scaled_solve(matrix: np.ndarray, rhs: np.ndarray, columns: np.ndarray) -> tuple[np.ndarray | None, float]:
@@ -568,9 +597,10 @@ def _newton(
     if not current["success"]:
         return _NewtonOutcome(False, current["message"], z, 0, None)
     norm = float(np.max(np.abs(current["residual"])))
+    sizes: list[float] = []
     for iteration in range(1, max_iterations + 1):
         if norm <= tol:
-            return _NewtonOutcome(True, f"residual {norm:.1e}", z, iteration - 1, current)
+            return _NewtonOutcome(True, f"residual {norm:.1e}", z, iteration - 1, current, tuple(sizes))
         step, ratio = _scaled_solve(current[jacobian_key], -current["residual"], columns)
         if step is None:
             return _NewtonOutcome(
@@ -578,11 +608,13 @@ def _newton(
                 f"singular Jacobian (σ_min/σ_max = {ratio:.1e}) at iteration {iteration}, residual {norm:.1e}: a fold "
                 "of the branch in this parameter, a bifurcation (internal resonance λ_k/ω ∈ ℤ) or a degenerate "
                 "amplitude — continue the branch with pseudo-arclength (continue_nnm) or change the parameter",
-                z, iteration, current,
+                z, iteration, current, tuple(sizes),
             )
         size = float(np.max(np.abs(step / columns)))
+        sizes.append(size)
         if size <= step_tol:
-            return _NewtonOutcome(True, f"residual {norm:.1e}, last step {size:.1e}", z + step, iteration, current)
+            return _NewtonOutcome(True, f"residual {norm:.1e}, last step {size:.1e}", z + step, iteration, current,
+                                  tuple(sizes))
         damping = 1.0
         for _ in range(max_backtracks + 1):
             trial = z + damping * step
@@ -597,13 +629,90 @@ def _newton(
                 False,
                 f"no convergence: no Newton step decreased the residual at iteration {iteration} "
                 f"(residual {norm:.1e}; last: {candidate.get('message') or 'larger residual'})",
-                z, iteration, current,
+                z, iteration, current, tuple(sizes),
             )
         z, current, norm = trial, candidate, trial_norm
     if norm <= tol:
-        return _NewtonOutcome(True, f"residual {norm:.1e}", z, max_iterations, current)
+        return _NewtonOutcome(True, f"residual {norm:.1e}", z, max_iterations, current, tuple(sizes))
     return _NewtonOutcome(False, f"no convergence in {max_iterations} Newton iterations (residual {norm:.1e})", z,
-                          max_iterations, current)
+                          max_iterations, current, tuple(sizes))
+
+
+_EXPANSION_LOCK = threading.Lock()
+
+
+class _ExpansionPredictor:
+    """Newton guesses from the strained-coordinates NNM expansion (:func:`lindstedt.nnm`, order 2).
+
+    The expansion of mode j at the release modal amplitude ``a0`` gives
+    ``ω(ε) = λ_j + ω_1 ε + ω_2 ε²`` and the release state
+    ``X(0) = Φ (a0 e_j + ε a)`` (velocities zero).  :meth:`guess` turns them
+    into shooting unknowns (for an energy amplitude the release state is scaled
+    about the static equilibrium to the target energy) and :meth:`valid` says
+    whether the series converges at ε (no :class:`~lindstedt.ExpansionValidityWarning`).
+    """
+
+    def __init__(self, problem: NNMShooting, expansion: Any, amplitude: _Amplitude) -> None:
+        self.problem = problem
+        self.expansion = expansion
+        self.amplitude = amplitude
+
+    @classmethod
+    def build(cls, problem: NNMShooting, epsilon: float, amplitude: _Amplitude) -> _ExpansionPredictor | None:
+        """The predictor for the amplitude at ε, or None where the expansion is not available."""
+        x0, _ = problem._guess_amplitude(epsilon, amplitude)
+        a0 = amplitude.value if amplitude.kind == "modal_amplitude" else float(problem.modal_row @ x0)
+        if not (math.isfinite(a0) and a0 != 0.0) or problem.system.n_springs == 0:
+            return None
+        key = (amplitude.kind, round(a0, 12))
+        cache = problem._expansions
+        if key not in cache:
+            from .. import nnm  # here: the expansion engine is only needed when a guess is asked for
+
+            try:
+                # one expansion at a time: mpmath's working precision is process-global (nnm_sweep may use threads)
+                with _EXPANSION_LOCK, warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    cache[key] = nnm(problem.system, problem.mode, a0=a0, order=2)
+            except Exception:  # noqa: BLE001 — a predictor only: any failure of the expansion means "no predictor"
+                cache[key] = None
+        expansion = cache[key]
+        return None if expansion is None else cls(problem, expansion, amplitude)
+
+    def frequency(self, epsilon: float) -> tuple[float, bool]:
+        """ω(ε) of the expansion and whether the series converges there."""
+        from .. import ExpansionValidityWarning
+
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                omega = float(self.expansion.frequency(float(epsilon)))
+            except (ArithmeticError, ValueError):
+                return math.nan, False
+        valid = not any(issubclass(w.category, ExpansionValidityWarning) for w in caught)
+        return omega, valid and math.isfinite(omega) and omega > 0
+
+    def valid(self, epsilon: float) -> bool:
+        """Whether the expansion's series converges at ε (its validity warning is not raised)."""
+        return self.frequency(epsilon)[1]
+
+    def guess(self, epsilon: float) -> np.ndarray | None:
+        """Shooting unknowns (X0, [X1,] T) predicted at ε, or None when ω(ε) is not positive."""
+        problem = self.problem
+        omega, _ = self.frequency(epsilon)
+        if not (math.isfinite(omega) and omega > 0):
+            return None
+        x0 = np.asarray(self.expansion.release_state(float(epsilon)), dtype=float)
+        if self.amplitude.kind != "modal_amplitude":  # scale about the equilibrium to the target energy
+            equilibrium = _equilibrium(problem.system, epsilon)
+            floor = nnm_energy(problem.system, equilibrium, np.zeros(problem.n), epsilon)
+            level = nnm_energy(problem.system, x0, np.zeros(problem.n), epsilon) - floor
+            excess = self.amplitude.target(epsilon) - floor
+            if level > 0 and excess > 0:
+                x0 = equilibrium + math.sqrt(excess / level) * (x0 - equilibrium)
+        if not np.all(np.isfinite(x0)):
+            return None
+        return problem._join(x0, np.zeros(problem.n), _TWO_PI / omega)
 
 
 def _impossible_amplitude(problem: NNMShooting, epsilon: float, amplitude: _Amplitude) -> str | None:
@@ -668,8 +777,17 @@ def nnm_point(
     formulation : {"symmetric", "full"}
         Half-period form for orbits released from rest (default) or the
         seed's full-period form with the phase condition ``φ_jᵀ M X'(0) = 0``.
-    initial_guess : NNMResult or (X0, T), optional
-        Default: the linear mode j with the requested amplitude, T = 2π/λ_j.
+    initial_guess : NNMResult, (X0, T), "linear", "expansion" or None
+        An orbit or a pair ``(X0, T)``: Newton from it, nothing else.
+        ``"linear"``: Newton from the linear mode j with the requested
+        amplitude, ``T = 2π/λ_j``, nothing else.  ``"expansion"``: Newton from
+        the strained-coordinates expansion (:func:`lindstedt.nnm`, order 2:
+        ``ω(ε)`` and the release state ``Φ (a0 e_j + ε a)``) and, if that
+        fails (ε beyond the expansion's validity), continuation in ε
+        (:func:`continue_nnm`, with its resonance jumps) from the largest
+        ``ε/2**k`` where the expansion holds, or from ε = 0.  None (default):
+        the linear mode first, then as ``"expansion"``.  The message names the
+        route that succeeded; the cost counters include every attempt.
     release_sign : {1, -1}
         Energy amplitudes: release on the ``+φ_j`` or ``−φ_j`` side.
     tol : float
@@ -687,9 +805,9 @@ def nnm_point(
     Returns
     -------
     NNMResult
-        ``success`` is False (with the reason in ``message``) on an impossible
-        energy, a singular Jacobian, no convergence, a flow failure or a failed
-        verification; no exception is raised for those.
+        ``success`` is False (with the reason in ``message``: every route
+        tried) on an impossible energy, a singular Jacobian, no convergence, a
+        flow failure or a failed verification; no exception is raised for those.
 
     Examples
     --------
@@ -708,7 +826,16 @@ def nnm_point(
     impossible = _impossible_amplitude(problem, epsilon, problem.amplitude)
     if impossible:
         return problem._failure(epsilon, impossible)
-    return problem._solve(_guess_unknowns(problem, epsilon, initial_guess), epsilon, tol=tol,
-                          max_iterations=max_iterations, verify_tol=verify_tol, stability_tol=stability_tol,
-                          min_mode_share=min_mode_share)
+    options = dict(tol=tol, max_iterations=max_iterations, verify_tol=verify_tol, stability_tol=stability_tol)
+    if initial_guess is None or isinstance(initial_guess, str):
+        routes = {None: ("linear", "expansion"), "linear": ("linear",), "expansion": ("expansion",)}
+        if initial_guess not in routes:
+            raise ProblemError(f"initial_guess must be an NNMResult, a pair (X0, T), 'linear', 'expansion' or None, "
+                               f"got {initial_guess!r}")
+        from .continuation import _robust_point  # here: the continuation module imports this one
+
+        return _robust_point(problem, epsilon, problem.amplitude, options, min_mode_share=min_mode_share,
+                             guesses=routes[initial_guess], homotopy=initial_guess != "linear")
+    return problem._solve(_guess_unknowns(problem, epsilon, initial_guess), epsilon,
+                          min_mode_share=min_mode_share, **options)
 
