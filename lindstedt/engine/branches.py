@@ -73,11 +73,15 @@ class ContactState:
 
     ``powers`` lists ``(m, c_m)``, m ≥ 2, of a polynomial contact law; it acts on a
     single component (N = 1: the 1-dof oscillator with a piecewise-polynomial f).
+    ``rank_one`` lists pairs ``(g, c)`` adding ``g cᵀ`` to L (``stiffness`` holds the dense
+    rest, or is empty): the N-dof normal form's ``L_p = Σ_{i active} G_i B_iᵀ``, applied as
+    one projection ``c · W`` and one rank-one update per pair, O(N) instead of O(N²).
     """
 
     stiffness: tuple[tuple[Any, ...], ...]
     load: tuple[Any, ...]
     powers: tuple[tuple[int, Any], ...] = ()
+    rank_one: tuple[tuple[tuple[Any, ...], tuple[Any, ...]], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -292,6 +296,16 @@ def _evaluate_terms(parity: int, frequency: np.ndarray, power: np.ndarray, value
     return slope @ value
 
 
+def _combination(domain: Any, branches: Sequence[Branch], weights: Sequence[Any]) -> Branch:
+    """Σ_l weights[l] · branches[l], accumulated in one dictionary (a chain of Branch sums would copy O(N²) terms)."""
+    terms: dict = {}
+    for branch, weight in zip(branches, weights):
+        if weight:
+            for key, value in branch.terms.items():
+                terms[key] = terms[key] + value * weight if key in terms else value * weight
+    return Branch(domain, terms)
+
+
 def fold(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Reduce s to [0, π] using evenness and 2π-periodicity; also the sign of d/ds."""
     shifted = np.mod(s + np.pi, 2 * np.pi) - np.pi
@@ -344,16 +358,22 @@ class BranchHierarchy(LazyOrders):
         # r_k as domain elements (the mode component's frequency is 1)
         self._ratio_elements = [domain.one if ratio is None else ratio for ratio in system.ratios]
         self.counters = {"orders": 0}
+        # orders whose components k ≠ j wait to be solved (see _solve_order), and their gaps' known part
+        self._pending: dict[int, list[int]] = {}
+        self._gap_parts: dict[int, list[Any]] = {}
+        self._projection_cache: dict[tuple[int, int], list[Branch]] = {}
 
     # -- read access ---------------------------------------------------------------------------------
     def branches(self, order: int) -> list[list[Branch]]:
         """W_order: ``branches(order)[piece][component]``."""
         self._ensure(order)
+        self._complete(order)
         return self._branches[order]
 
     def boundary_shift(self, order: int) -> list[Any]:
         """σ_{i,order} for every boundary (order 0: the contact angles β_i)."""
         self._ensure(order + self._lag)
+        self._complete(order + self._lag)
         return [shifts[order] for shifts in self._shifts]
 
     def release(self, order: int, component: int) -> Any:
@@ -446,9 +466,48 @@ class BranchHierarchy(LazyOrders):
 
     # -- one order -------------------------------------------------------------------------------------
     def _solve_order(self, order: int) -> None:
+        """Order ``order``: every component when the system is coupled (a stretched arc, N = 1); otherwise
+        only the mode component j (A_n and W_{n,j}) — the components k ≠ j and the shifts σ_n are
+        solved by :meth:`_complete` when something asks for them (order n + 1, branches, shifts)."""
+        self._complete(order - 1)
+        system = self.system
+        if system.size == 1 or system.arcs != (None, None):
+            self._solve_components(order, list(range(system.size)), coupled=True)
+        else:
+            self._branches.append([[None] * system.size for _ in system.states])
+            self._gap_parts[order] = [self._domain.zero] * len(system.boundaries)
+            self._solve_components(order, [system.mode], coupled=False)
+            self._pending[order] = [k for k in range(system.size) if k != system.mode]
+        self.counters["orders"] += 1
+
+    def _complete(self, order: int) -> None:
+        """Solve the deferred components k ≠ j of ``order`` (each alone: for k ≠ j order n involves only
+        c_k, given the lower orders) and then the boundary shifts σ_n from the whole gap Σ_k c_ik W_{n,k}."""
+        pending = self._pending.pop(order, None)
+        if pending is None:
+            return
+        for component in pending:
+            self._solve_components(order, [component], coupled=False)
+        one, mode = self._domain.one, self.system.mode
+        for index, (boundary, gap) in enumerate(zip(self.system.boundaries, self._gap_parts.pop(order))):
+            if not boundary.grazing:
+                self._shifts[index].append(gap * (one / (boundary.coupling[mode] * boundary.sine)))
+            elif order >= 3:
+                curvature = -boundary.point.cos_multiple(1)
+                self._shifts[index].append(gap * (-one / (boundary.coupling[mode] * curvature * boundary.first_shift)))
+
+    def _solve_components(self, order: int, components: list[int], coupled: bool) -> None:
+        """Order ``order`` for ``components``: unknowns A_n (index 0) and c_k on the first piece (1 + position).
+
+        ``coupled``: ``components`` is the whole system; the shifts σ_n are solved here (affine, as the
+        stretched arcs need them among the unknowns).  Otherwise the components' share of every gap is
+        added to ``_gap_parts[order]`` and A_n is the unknown only for the mode component (a group
+        without it takes A_n as known: it does not enter the equations of k ≠ j at order n).
+        """
         system, domain = self.system, self._domain
         zero, one = domain.zero, domain.one
-        size, mode = system.size, system.mode
+        mode = system.mode
+        size = len(components)
         resonant = self._resonant
         top, bottom = system.arcs
         # A_n, then c_k on the first piece for every component k (σ_{1,n} with a first-piece arc),
@@ -468,31 +527,38 @@ class BranchHierarchy(LazyOrders):
             if (piece == 0 and top is not None) or (piece == last_piece and bottom is not None):
                 particular.append([Branch(domain)])  # the stretched arc solves this piece itself
                 continue
-            components = []
-            for k in range(size):
+            previous = self._branches[order - system.gauge][piece] if order >= system.gauge else None
+            # L W = Σ g (c · W): the projections c · W_{n−1} once per piece (memoised: the components
+            # k ≠ j are solved one by one), then one rank-one update per component
+            projections = self._projections(order, piece, state, previous) if state.rank_one and previous else []
+            components_rhs = []
+            for k in components:
                 rhs = Branch(domain)
                 for i in range(1, order):
                     rhs = rhs - self._derivative(order - i, piece, k, 2).scale(self._squared[i])
-                for l, entry in enumerate(state.stiffness[k]):
-                    if entry and order >= system.gauge:
-                        rhs = rhs - self._branches[order - system.gauge][piece][l].scale(entry)
+                for l, entry in enumerate(state.stiffness[k] if state.stiffness and previous else ()):
+                    if entry:
+                        rhs = rhs - previous[l].scale(entry)
+                if projections:
+                    rhs = rhs - _combination(domain, projections, [forcing[k] for forcing, _ in state.rank_one])
                 if order == system.gauge and state.load[k]:
                     rhs = rhs - Branch.constant(domain, state.load[k])
                 if order >= system.gauge:
                     for power, coefficient in state.powers:
                         rhs = rhs - self._law_power(piece, power, order - system.gauge).scale(coefficient)
-                components.append(rhs.oscillator_particular_solution(system.ratios[k]))
-            particular.append(components)
+                components_rhs.append(rhs.oscillator_particular_solution(system.ratios[k]))
+            particular.append(components_rhs)
 
         # the particular solutions' slopes, each formed once per order (they are evaluated at every boundary)
-        particular_slopes = [[branch.derivative() for branch in components] for components in particular]
+        particular_slopes = [[branch.derivative() for branch in pieces] for pieces in particular]
         ratios = self._ratio_elements
 
-        def value_of(piece: int, k: int, c: _Affine, d: _Affine, point: EvaluationPoint, slope: bool) -> _Affine:
-            """W_{n,k}^piece (or its slope) at point, for homogeneous parts c, d."""
+        def value_of(piece: int, position: int, c: _Affine, d: _Affine, point: EvaluationPoint, slope: bool) -> _Affine:
+            """W_{n,k}^piece (or its slope) at point, for homogeneous parts c, d (k = components[position])."""
+            k = components[position]
             frequency = system.frequency(k)
             cosine, sine = point.cos_multiple(frequency), point.sin_multiple(frequency)
-            branch = particular_slopes[piece][k] if slope else particular[piece][k]
+            branch = particular_slopes[piece][position] if slope else particular[piece][position]
             result = constant(branch.evaluate(point))
             if k == mode:
                 result = result + unit(0).scale((self._resonant_slope if slope else resonant).evaluate(point))
@@ -501,10 +567,11 @@ class BranchHierarchy(LazyOrders):
             return result + c.scale(cosine) + d.scale(sine)
 
         # First piece: c_k free, d_k from W_k'(0) = 0 (d_k r_k + slope without d = 0).
-        c_values = [[unit(1 + k) for k in range(size)]]
-        d_values = [[value_of(0, k, c_values[0][k], constant(zero), system.zero_point, True).scale(-one / ratios[k])
-                     for k in range(size)]]
+        c_values = [[unit(1 + p) for p in range(size)]]
+        d_values = [[value_of(0, p, c_values[0][p], constant(zero), system.zero_point, True).scale(-one / ratios[k])
+                     for p, k in enumerate(components)]]
         shift_values: list[_Affine | None] = []
+        gaps: list[_Affine] = []
         for index, boundary in enumerate(system.boundaries):
             point = boundary.point
             powers = self._shift_powers(index, order)
@@ -516,14 +583,18 @@ class BranchHierarchy(LazyOrders):
                 shift_values.append(unit(1))
                 continue
             # W_{n,k} on the left piece at β, and its known Taylor terms there (W_order and σ_order excluded)
-            values = [value_of(left, k, c_values[left][k], d_values[left][k], point, False) for k in range(size)]
-            known = [self._known(index, left, k, order, 0, powers) for k in range(size)]
+            values = [value_of(left, p, c_values[left][p], d_values[left][p], point, False) for p in range(size)]
+            known = [self._known(index, left, k, order, 0, powers) for k in components]
             # Contact: Σ_k c_k W_k(s*) = κ  ->  order n: Σ_k c_k [W_{n,k}(β) + known_k] + c_j W_0'(β) σ_n = 0, W_0' = −sin β.
             gap = constant(zero)
-            for k, coupling in enumerate(boundary.coupling):
+            for p, k in enumerate(components):
+                coupling = boundary.coupling[k]
                 if coupling:
-                    gap = gap + values[k].shift(known[k]).scale(coupling)
-            if not boundary.grazing:
+                    gap = gap + values[p].shift(known[p]).scale(coupling)
+            gaps.append(gap)
+            if not coupled:
+                pass  # the shifts need every component: _complete
+            elif not boundary.grazing:
                 shift_values.append(gap.scale(one / (boundary.coupling[mode] * boundary.sine)))
             elif order >= 3:
                 # σ_{n−1} first appears here, through c_j W_0''(β) σ_1 σ_{n−1} (W_0'' = −cos β = −κ_j);
@@ -536,12 +607,12 @@ class BranchHierarchy(LazyOrders):
                 break  # the last arc is matched below (slope and frequency conditions)
             # C¹ matching of every component: the homogeneous parts of the right piece.
             c_next, d_next = [], []
-            for k in range(size):
-                slope = value_of(left, k, c_values[left][k], d_values[left][k], point, True)
-                x = values[k].shift(known[k] - self._known(index, right, k, order, 0, powers))
+            for p, k in enumerate(components):
+                slope = value_of(left, p, c_values[left][p], d_values[left][p], point, True)
+                x = values[p].shift(known[p] - self._known(index, right, k, order, 0, powers))
                 y = slope.shift(self._known(index, left, k, order, 1, powers) - self._known(index, right, k, order, 1, powers))
-                x = x - value_of(right, k, constant(zero), constant(zero), point, False)
-                y = y - value_of(right, k, constant(zero), constant(zero), point, True)
+                x = x - value_of(right, p, constant(zero), constant(zero), point, False)
+                y = y - value_of(right, p, constant(zero), constant(zero), point, True)
                 frequency = system.frequency(k)
                 cosine, sine = point.cos_multiple(frequency), point.sin_multiple(frequency)
                 c_next.append(x.scale(cosine) - y.scale(sine / ratios[k]))
@@ -550,7 +621,7 @@ class BranchHierarchy(LazyOrders):
             d_values.append(d_next)
         last = last_piece
         if bottom is None:
-            equations = [value_of(last, k, c_values[last][k], d_values[last][k], system.pi_point, True) for k in range(size)]
+            equations = [value_of(last, p, c_values[last][p], d_values[last][p], system.pi_point, True) for p in range(size)]
         else:
             index = len(system.boundaries) - 1
             bottom_mu, bottom_quotient, slope_condition = self._match_last_arc(
@@ -559,32 +630,40 @@ class BranchHierarchy(LazyOrders):
                 constant, unit(turning),
             )
             equations = [slope_condition, self._arc_frequency_condition(1, order, bottom_mu, shift_values[index].scale(-domain.one), unit)]
-        if top is not None:  # the release is the arc's; the unknowns are tied by A_n = [μ s_1*²]_n
+        if mode not in components:
+            equations.append(unit(0).shift(-self._squared[order]))  # A_n is known: solved with the mode component
+        elif top is not None:  # the release is the arc's; the unknowns are tied by A_n = [μ s_1*²]_n
             equations.append(self._arc_frequency_condition(0, order, constant(self._arc_data[0]["mu"][order]), unit(1), unit))
         elif self.normalization == "initial":
-            release = value_of(0, mode, c_values[0][mode], d_values[0][mode], system.zero_point, False)
+            position = components.index(mode)
+            release = value_of(0, position, c_values[0][position], d_values[0][position], system.zero_point, False)
             prescribed = system.release_at(order)
             equations.append(release if prescribed is None else release.shift(-prescribed))
         else:
-            equations.append(self._first_harmonic_condition(order, particular, c_values, d_values, unit(0)))
+            equations.append(self._first_harmonic_condition(order, particular, c_values, d_values, unit(0), components.index(mode)))
         unknowns = solve_linear([list(e.coefficients) for e in equations], [-e.base for e in equations], domain, order)
-        branches = []
+        branches = [[None] * system.size for _ in system.states] if coupled else self._branches[order]
         for piece in range(len(system.states)):
             if (piece == 0 and top is not None) or (piece == last_piece and bottom is not None):
-                branches.append([Branch(domain)])  # the arc's own representation (StretchedArc) stands here
+                branches[piece] = [Branch(domain)]  # the arc's own representation (StretchedArc) stands here
                 continue
-            components = []
-            for k in range(size):
+            for p, k in enumerate(components):
                 frequency = system.frequency(k)
                 homogeneous = Branch(
                     domain,
-                    {(frequency, 0, 0): c_values[piece][k].value(unknowns), (frequency, 1, 0): d_values[piece][k].value(unknowns)},
+                    {(frequency, 0, 0): c_values[piece][p].value(unknowns), (frequency, 1, 0): d_values[piece][p].value(unknowns)},
                 )
-                branch = particular[piece][k] + homogeneous
+                branch = particular[piece][p] + homogeneous
                 if k == mode:
                     branch = branch + resonant.scale(unknowns[0])
-                components.append(branch)
-            branches.append(components)
+                branches[piece][k] = branch
+        if not coupled:
+            parts = self._gap_parts[order]
+            for index, gap in enumerate(gaps):
+                parts[index] = parts[index] + gap.value(unknowns)
+            if mode in components:
+                self._squared.append(unknowns[0])
+            return
         self._branches.append(branches)
         self._squared.append(unknowns[0])
         for shifts, value in zip(self._shifts, shift_values):
@@ -599,7 +678,15 @@ class BranchHierarchy(LazyOrders):
             data["quotient"].append(bottom_quotient.value(unknowns))
             data["length"].append(-self._shifts[-1][order])
             bottom.fix(order, unknowns[turning])
-        self.counters["orders"] += 1
+
+    def _projections(self, order: int, piece: int, state: ContactState, previous: list[Branch]) -> list[Branch]:
+        """c · W_{n−gauge} on ``piece`` for every rank-one term (c, g) of the piece's law, formed once per order."""
+        key = (order, piece)
+        if key not in self._projection_cache:
+            if any(cached != order for cached, _ in self._projection_cache):
+                self._projection_cache.clear()
+            self._projection_cache[key] = [_combination(self._domain, previous, coupling) for _, coupling in state.rank_one]
+        return self._projection_cache[key]
 
     def _match_first_arc(self, order: int, point: EvaluationPoint, boundary: MovingBoundary, powers: list, value_of: Any, constant: Any, unit: Any) -> tuple:
         """The next piece's homogeneous parts from the first arc's end: W(s*) = κ, W'(s*) = Y'(1)/s*, at order n.
@@ -660,10 +747,10 @@ class BranchHierarchy(LazyOrders):
             total = total.shift(mus[i] * squared(order - i))
         return unit(0) - total
 
-    def _first_harmonic_condition(self, order: int, particular: list, c_values: list, d_values: list, resonant_unit: _Affine) -> _Affine:
-        """ε̂^order coefficient of ∫_0^π W_j cos s ds (must vanish), affine in the unknowns."""
+    def _first_harmonic_condition(self, order: int, particular: list, c_values: list, d_values: list, resonant_unit: _Affine,
+                                  mode: int) -> _Affine:
+        """ε̂^order coefficient of ∫_0^π W_j cos s ds (must vanish), affine in the unknowns (``mode``: W_j's position)."""
         system, domain = self.system, self._domain
-        mode = system.mode
         limits = [system.zero_point] + [b.point for b in system.boundaries] + [system.pi_point]
         cos_cos = Branch.cosine(domain).times_cosine(1)
         sin_cos = Branch.sine(domain).times_cosine(1)

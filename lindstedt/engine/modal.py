@@ -19,7 +19,11 @@ Between consecutive angles the active set is fixed and the law is linear,
 :class:`~lindstedt.engine.branches.BranchSystem` with N components, solved by
 the one branch hierarchy.  Its release ``W_{1,j}(0) = a1 λ_j² / a0`` comes from
 ``u_j(0) = a0 + ε a1``.  The arithmetic is a ``RealField`` of the requested
-precision; the mode shapes are computed there with mpmath.
+precision.  Of the modes the normal form needs only the λ_k and the contact
+projections ``B = A Φ``, ``G = Φᵀ W`` (O(N·m) numbers, from
+:meth:`~lindstedt.problems.system.UnilateralSystem.modal_coupling`: float64 modes
+refined in multiprecision), and ``L_p`` enters the hierarchy as its rank-one terms
+``G_i B_iᵀ`` (:class:`~lindstedt.engine.branches.ContactState`), never as an N × N matrix.
 """
 
 from __future__ import annotations
@@ -135,18 +139,18 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
         value = value if isinstance(value, sympy.Basic) else sympy.Float(value, digits + 10)
         return domain.from_sympy(sympy.N(value, digits + 10))
 
-    frequencies, shapes = system.modes_high_precision(digits + 10)
-    frequencies = [convert(value) for value in frequencies]
-    shapes = [[convert(value) for value in column] for column in shapes]  # shapes[k][row]
+    # λ_k and the contact projections B = A Φ, G = Φᵀ W: all the normal form needs of the modes (O(N·m) numbers)
+    lambdas, coupling_rows, forcing_rows = system.modal_coupling(digits + 10)
+    frequencies = [domain.dtype(value) for value in lambdas]
     a0 = convert(amplitude)
     lam = frequencies[mode]
     ratios = [value / lam for value in frequencies]
     small_divisors = _small_divisors(ratios, mode)
-    A = [[convert(v) for v in row] for row in system.A_exact.tolist()]
-    W = [[convert(v) for v in row] for row in system.W_exact.tolist()]
     gaps = [convert(v) for v in list(system.b_exact)]
-    B = [[sum((A[i][row] * shapes[k][row] for row in range(size)), domain.zero) for k in range(size)] for i in range(springs_count)]
-    G = [[sum((shapes[k][row] * W[row][i] for row in range(size)), domain.zero) for i in range(springs_count)] for k in range(size)]
+    B = [[domain.dtype(value) for value in row] for row in coupling_rows]  # B[i][k]
+    G = [[domain.dtype(value) for value in row] for row in forcing_rows]  # G[k][i]
+    forcing_columns = [tuple(G[k][i] for k in range(size)) for i in range(springs_count)]
+    coupling_vectors = [tuple(B[i]) for i in range(springs_count)]
     springs = tuple(_classify(i, a0 * B[i][mode], gaps[i], digits, mode) for i in range(springs_count))
     pi = domain.convert(sympy.N(sympy.pi, digits + 10))
     zero_point = EvaluationPoint(domain, domain.zero, domain.one, domain.zero)
@@ -188,9 +192,9 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
                 if (s.status == "always" or s.touches_from_contact or (s.status == "crossing" and ((cosine > s.kappa) if s.orientation > 0 else (cosine < s.kappa))))
                 != (s.index in flips)
             ]
-            stiffness = tuple(tuple(sum((G[k][i] * B[i][l] for i in active), domain.zero) for l in range(size)) for k in range(size))
+            # L_p = Σ_{i active} G_i B_iᵀ as rank-one terms (never an N × N matrix)
             load = tuple(-sum((G[k][i] * gaps[i] for i in active), domain.zero) / a0 for k in range(size))
-            states.append(ContactState(stiffness, load))
+            states.append(ContactState((), load, rank_one=tuple((forcing_columns[i], coupling_vectors[i]) for i in active)))
         return BranchSystem(
             domain=domain,
             ratios=tuple(None if k == mode else ratio for k, ratio in enumerate(ratios)),

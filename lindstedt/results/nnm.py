@@ -18,8 +18,15 @@ import mpmath
 import numpy as np
 import sympy
 
-from ..engine.branches import BranchHierarchy, FloatBranches
-from .accuracy import ExpansionValidityWarning, branch_bound, displacement_error, gauge_values, phase_warning, series_warning
+from ..engine.branches import BranchHierarchy, FloatBranches, fold
+from .accuracy import (
+    ExpansionValidityWarning,
+    branch_bound,
+    displacement_error,
+    gauge_values,
+    phase_warning,
+    series_warning,
+)
 from ..problems.nnm import NNMProblem
 from ..problems.system import UnilateralSystem
 
@@ -108,7 +115,9 @@ class NNMExpansion:
         """ω(ε) = Σ_n ω_n η^n (vectorised), η = ε, or ε^{1/2} when ``gauge`` is 2.
 
         Warns (:class:`~lindstedt.ExpansionValidityWarning`) where the series does not
-        converge: its terms grow, or the next term exceeds the whole correction.
+        converge: its terms grow, or the next term exceeds the whole correction.  The first
+        call derives that next term ω_{n+1} (see :meth:`truncation_error_estimate`); later
+        calls are one polynomial evaluation.
 
         Examples
         --------
@@ -126,15 +135,19 @@ class NNMExpansion:
         message = series_warning(self._coefficients, len(self.omega) - 1, np.atleast_1d(eta), self._gauge_name)
         if message:
             warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
-        return np.polynomial.polynomial.polyval(eta, self._coefficients[:-1])
+        return np.polynomial.polynomial.polyval(eta, self._known_coefficients)
 
     def truncation_error_estimate(self, epsilon: Any) -> Any:
-        """|ω_{n+1} η^{n+1}|: the size of the first neglected term of ω(ε) (vectorised)."""
+        """|ω_{n+1} η^{n+1}|: the size of the first neglected term of ω(ε) (vectorised).
+
+        The first call derives ω_{n+1}: order n + 1 of the hierarchy, which needs every W_{n,k} (O(N²) terms).
+        """
         return np.abs(self._coefficients[-1] * self._gauge_values(epsilon) ** len(self.omega))
 
     def displacement_error_estimate(self, t: Any, epsilon: float) -> np.ndarray:
         """Estimated error of :meth:`modal_displacement` at ``t`` (vectorised, the worst modal coordinate): the phase
         drift |a0 ω_{n+1} η^{n+1}| t plus the first neglected waveform term (the last kept one times η̂).
+        Derives ω_{n+1} on first use (see :meth:`truncation_error_estimate`).
 
         Examples
         --------
@@ -147,18 +160,27 @@ class NNMExpansion:
         lam = float(self.omega[0])
         scaled = eta * (lam * lam) ** (-1 / self.gauge)
         last = len(self.omega) - 1
-        kept = self._float_branches.terms[-1]  # W_{n−1}: the waveform pairs orders < n with ω through n
-        neglected = abs(self.a0) * abs(scaled) ** len(self._float_branches.terms) * branch_bound(kept, self._float_branches.shifts[0])
+        neglected = abs(self.a0) * abs(scaled) ** len(self._float_branches.terms) * self._last_branch_bound
         frequency_error = abs(self._coefficients[-1]) * abs(eta) ** (last + 1)
         return displacement_error(self.a0, frequency_error, np.asarray(t, dtype=float), neglected)
+
+    @cached_property
+    def _last_branch_bound(self) -> float:
+        """max |W_{n−1}| over [0, π] (sampled once): the waveform pairs orders < n with ω through n."""
+        return branch_bound(self._float_branches.terms[-1], self._float_branches.shifts[0])
 
     @property
     def _gauge_name(self) -> str:
         return "eps" if self.gauge == 1 else "sqrt(eps)"
 
     @cached_property
+    def _known_coefficients(self) -> np.ndarray:
+        """ω_0 … ω_n as floats."""
+        return np.array([float(w) for w in self.omega])
+
+    @cached_property
     def _coefficients(self) -> np.ndarray:
-        """ω_0 … ω_n and the next coefficient ω_{n+1} (derived on first use), as floats."""
+        """ω_0 … ω_n and the next coefficient ω_{n+1} (derived on first use: order n + 1 of the hierarchy), as floats."""
         lam = self.omega[0]
         steps = self.gauge
         index = steps * self.order + 1
@@ -168,30 +190,53 @@ class NNMExpansion:
     def _gauge_values(self, epsilon: Any) -> np.ndarray:
         return gauge_values(epsilon, self.gauge, "use lindstedt.nnm_point")
 
-    def modal_displacement(self, t: Any, epsilon: float) -> np.ndarray:
-        """Modal coordinates U(t) ≈ a0 Σ_{n<N} ε̂^n W_n(ω t), ω through ω_N (shape ``t.shape + (N_dof,)``).
+    def modal_displacement(self, t: Any, epsilon: Any) -> np.ndarray:
+        """Modal coordinates U(t) ≈ a0 Σ_{n<N} ε̂^n W_n(ω t), ω through ω_N (shape ``broadcast(t, ε).shape + (N_dof,)``).
 
         The branches are used between the *moving* contact angles s_i*(ε); with the
         frequency through ω_N and the waveforms through order N−1 the error is O(ε^N)
-        on t ≤ C/ε (Theorem 4.1 for N = 2: u = v⁰ + ε v¹ + O(ε²)).
+        on t ≤ C/ε (Theorem 4.1 for N = 2: u = v⁰ + ε v¹ + O(ε²)).  Vectorised over ``t``
+        and ``epsilon`` (broadcast together); the branches are compiled once per expansion
+        into one sparse (terms × components) matrix per piece and order, so a call costs a
+        few array operations, not a loop over the N components.
+
+        Examples
+        --------
+        >>> import lindstedt, numpy as np
+        >>> mode = lindstedt.nnm(lindstedt.UnilateralSystem.chain(3, unilateral=[(0, 0)]), mode=1, a0=1.0)
+        >>> mode.modal_displacement(np.linspace(0, 1, 4), [[0.0], [0.01]]).shape
+        (2, 4, 3)
         """
         lam = float(self.omega[0])
-        eta = float(self._gauge_values(float(epsilon)))
         times = np.asarray(t, dtype=float)
+        epsilons = np.asarray(epsilon, dtype=float)
+        eta = self._gauge_values(epsilons)
         last = len(self.omega) - 1
-        message = series_warning(self._coefficients, last, np.array([eta]), self._gauge_name) or phase_warning(
-            abs(self._coefficients[-1]) * abs(eta) ** (last + 1), times
+        message = series_warning(self._coefficients, last, np.atleast_1d(eta), self._gauge_name) or phase_warning(
+            abs(self._coefficients[-1]) * float(np.max(np.abs(eta), initial=0.0)) ** (last + 1), times
         )
         if message:
             warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
-        strained = times * float(np.polynomial.polynomial.polyval(eta, self._coefficients[:-1]))
+        strained = times * np.polynomial.polynomial.polyval(eta, self._known_coefficients)
         scaled = eta * (lam * lam) ** (-1 / self.gauge)
-        return self.a0 * self._float_branches.evaluate(strained, scaled)
+        if not scaled.ndim:
+            return self.a0 * self._compiled.evaluate(strained, float(scaled))
+        strained, scaled = np.broadcast_arrays(strained, scaled)
+        result = np.empty(strained.shape + (self.system.n_dof,))
+        for value in np.unique(scaled):  # one evaluation per distinct ε (the contact angles move with it)
+            mask = scaled == value
+            result[mask] = self._compiled.evaluate(strained[mask], float(value))
+        return self.a0 * result
 
     @cached_property
     def _float_branches(self) -> FloatBranches:
         """W_0 … W_{N−1} as floats (built once)."""
         return self._hierarchy.float_branches(max(self.gauge * self.order - 1, 0))
+
+    @cached_property
+    def _compiled(self) -> "_CompiledWaveform":
+        """W_0 … W_{N−1} compiled for evaluation over every component at once (built once)."""
+        return _CompiledWaveform(self._float_branches)
 
     def displacement(self, t: Any, epsilon: float) -> np.ndarray:
         """Physical X(t) = Φ U(t) of :meth:`modal_displacement` (shape ``t.shape + (N_dof,)``).
@@ -254,3 +299,64 @@ class NNMExpansion:
         lines.append("  a_k = " + ", ".join(mpmath.nstr(value, 12) for value in self.a_k))
         lines.append(f"  validity: T ~ eps^({self.validity_exponent}); spring roots: {', '.join(self.spring_roots)}")
         return "\n".join(lines)
+
+
+class _CompiledWaveform:
+    """Σ_n η̂^n W_n(s) for every component at once, from :class:`~lindstedt.engine.branches.FloatBranches`.
+
+    Per piece of [0, π]: the distinct terms (ν, parity, m) of all components and orders, the distinct
+    frequencies ν among them, and per order a sparse (terms × components) coefficient matrix.  An
+    evaluation forms cos/sin of the distinct frequencies at the points of each piece once and multiplies
+    by the ε̂-weighted sum of the sparse matrices: O(points × terms + nonzeros), no Python loop over
+    components.  (The NNM's branches have no stretched arcs.)
+    """
+
+    def __init__(self, branches: FloatBranches):
+        import scipy.sparse  # here, not at module level: import lindstedt stays light
+
+        if branches.arcs != (None, None):
+            raise ValueError("stretched arcs are evaluated by FloatBranches")  # pragma: no cover - not in an NNM
+        self.shifts = np.array(branches.shifts, dtype=float).reshape(len(branches.shifts), -1)
+        self.orders = len(branches.terms)
+        self.size = len(branches.terms[0][0])
+        self.pieces = []
+        for piece in range(len(branches.terms[0])):
+            keys: dict[tuple[float, int, int], int] = {}
+            entries: list[tuple[list[int], list[int], list[float]]] = []
+            for order_terms in branches.terms:
+                rows, columns, values = [], [], []
+                for component, terms in enumerate(order_terms[piece]):
+                    for frequency, parity, power, value in terms:
+                        rows.append(keys.setdefault((float(frequency), parity, power), len(keys)))
+                        columns.append(component)
+                        values.append(value)
+                entries.append((rows, columns, values))
+            ordered = list(keys)
+            frequencies, inverse = np.unique(np.array([key[0] for key in ordered] or [0.0]), return_inverse=True)
+            matrices = [
+                scipy.sparse.csr_matrix((values, (rows, columns)), shape=(max(len(ordered), 1), self.size)) for rows, columns, values in entries
+            ]
+            parity = np.array([key[1] for key in ordered] or [0])
+            power = np.array([key[2] for key in ordered] or [0], dtype=float)
+            self.pieces.append((frequencies, inverse[: len(ordered) or 1], parity, power, matrices))
+
+    def evaluate(self, strained_time: Any, scaled_epsilon: float) -> np.ndarray:
+        """Σ_n ε̂^n W_n(s) at the strained times s; shape ``s.shape + (N,)``."""
+        folded, _ = fold(np.asarray(strained_time, dtype=float))
+        weights = float(scaled_epsilon) ** np.arange(self.orders)
+        result = np.zeros(folded.shape + (self.size,))
+        piece_index = np.searchsorted(weights @ self.shifts, folded) if len(self.pieces) > 1 else np.zeros(folded.shape, dtype=int)
+        for piece, (frequencies, index, parity, power, matrices) in enumerate(self.pieces):
+            mask = piece_index == piece
+            if not np.any(mask):
+                continue
+            points = folded[mask]
+            argument = np.multiply.outer(points, frequencies)
+            columns = np.where(parity == 0, np.cos(argument)[:, index], np.sin(argument)[:, index])
+            if power.any():
+                columns = columns * np.power.outer(points, power)
+            coefficients = matrices[0] * weights[0]
+            for weight, matrix in zip(weights[1:], matrices[1:]):
+                coefficients = coefficients + matrix * weight
+            result[mask] = np.asarray(coefficients.T @ columns.T).T
+        return result
