@@ -57,7 +57,7 @@ from sympy.printing.numpy import NumPyPrinter
 from .._errors import LindstedtError, ProblemError
 from .stable import SERIES_TARGET, Patch, StableCoefficient, stable_coefficient
 
-__all__ = ["GeneratedCode", "generate_code"]
+__all__ = ["GeneratedCode", "generate_code", "stable_function"]
 
 _LANGUAGES = ("numpy", "c")
 _QUANTITIES = ("frequency", "displacement")
@@ -432,6 +432,31 @@ def _wrapped(text: str, width: int = 100) -> list[str]:
     import textwrap
 
     return textwrap.wrap(text, width)
+
+
+def stable_function(expression: sympy.Expr, symbol: sympy.Symbol) -> Callable[[Any], np.ndarray] | None:
+    """A vectorised NumPy function of ``symbol`` evaluating ``expression`` (a gap coefficient ω_k(κ)) by the piecewise
+    exact series of :mod:`lindstedt.export.stable` (relative error <= 1e-13 on (-1, 1), NaN outside), or None if
+    the expression has another shape.  The same code as ``generate_code(expansion, "omega<k>")`` prints; the
+    series are generated once per expression (cached, 0.1-0.5 s).
+
+    Examples
+    --------
+    >>> import lindstedt, numpy as np
+    >>> e = lindstedt.expand("Max(0, u - kappa)", order=1, a0=1, omega0=1, params={"kappa": None})
+    >>> omega1 = stable_function(e.omega_correction(1), e.arguments[0])
+    >>> float(omega1(np.array(0.0)))      # 1/4 at kappa = 0
+    0.25
+    """
+    stable = _stable_coefficient_cached(expression, symbol)
+    if stable is None:
+        return None
+    renaming = _safe_names([symbol], _PYTHON_RESERVED)
+    name = renaming[symbol]
+    source = _stable_numpy_source("lindstedt_stable", name, [(0, _renamed(stable, symbol, name))], False, stable.summary)
+    namespace: dict[str, Any] = {"numpy": np}
+    exec(compile(source, "<lindstedt stable series>", "exec"), namespace)  # noqa: S102 - our own generated source
+    return namespace["lindstedt_stable"]
 
 
 @functools.lru_cache(maxsize=32)

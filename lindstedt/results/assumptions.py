@@ -17,9 +17,11 @@ from dataclasses import dataclass
 from functools import cached_property
 from typing import Any, Callable, Mapping
 
+import numpy as np
 import sympy
 
 from .._errors import ParameterError
+from ..export.stable import compile_family
 from ..problems.oscillator import Oscillator
 
 __all__ = ["DerivationAssumptions", "shown_values"]
@@ -70,6 +72,9 @@ def shown_values(substitution: Mapping[sympy.Symbol, sympy.Expr]) -> str:
     )
 
 
+_POSITIVE, _NEGATIVE, _ZERO, _NONZERO = frozenset({1}), frozenset({-1}), frozenset({0}), frozenset({-1, 1})
+
+
 @dataclass(frozen=True)
 class _Assumption:
     """One condition the derivation relied on, checked on numeric values (see :meth:`Expansion._validated`)."""
@@ -78,32 +83,40 @@ class _Assumption:
     holds: Callable[[Mapping[sympy.Symbol, sympy.Expr]], bool]
     amplitude_sign: bool = False
     rederivable: bool = True  # False: no expansion exists for such values (ω0 ≤ 0, a0 = 0)
+    # the same test for float values: every expression's sign must be in its set (empty: not expressible,
+    # checked exactly); ``integer`` names a symbol that must hold an integer
+    conditions: tuple[tuple[sympy.Expr, frozenset[int]], ...] = ()
+    integer: sympy.Symbol | None = None
 
 
 def _symbol_assumptions(symbol: sympy.Symbol, is_amplitude: bool, is_frequency: bool) -> list[_Assumption]:
     """The sign/integrality assumptions a free symbol was declared with (derivations may use them)."""
     facts = symbol.assumptions0
     name = symbol.name
-    checks: list[tuple[str, Callable[[int], bool]]] = []
+    checks: list[tuple[str, frozenset[int]]] = []
     if facts.get("positive"):
-        checks.append((f"{name} > 0 ({name} is declared positive)", lambda sign: sign > 0))
+        checks.append((f"{name} > 0 ({name} is declared positive)", _POSITIVE))
     elif facts.get("negative"):
-        checks.append((f"{name} < 0 ({name} is declared negative)", lambda sign: sign < 0))
+        checks.append((f"{name} < 0 ({name} is declared negative)", _NEGATIVE))
     elif facts.get("nonnegative"):
-        checks.append((f"{name} >= 0 ({name} is declared nonnegative)", lambda sign: sign >= 0))
+        checks.append((f"{name} >= 0 ({name} is declared nonnegative)", frozenset({0, 1})))
     elif facts.get("nonpositive"):
-        checks.append((f"{name} <= 0 ({name} is declared nonpositive)", lambda sign: sign <= 0))
+        checks.append((f"{name} <= 0 ({name} is declared nonpositive)", frozenset({-1, 0})))
     elif facts.get("nonzero"):
-        checks.append((f"{name} != 0 ({name} is declared nonzero)", lambda sign: sign != 0))
+        checks.append((f"{name} != 0 ({name} is declared nonzero)", _NONZERO))
     assumptions = [
-        _Assumption(text, lambda substitution, test=test: test(_numeric_sign(substitution[symbol])), is_amplitude, not is_frequency)
-        for text, test in checks
+        _Assumption(
+            text, lambda substitution, signs=signs: _numeric_sign(substitution[symbol]) in signs, is_amplitude, not is_frequency,
+            ((symbol, signs),),
+        )
+        for text, signs in checks
     ]
     if facts.get("integer"):
         assumptions.append(
             _Assumption(
                 f"{name} an integer ({name} is declared integer)",
                 lambda substitution: float(sympy.N(substitution[symbol], 30)).is_integer(),
+                integer=symbol,
             )
         )
     return assumptions
@@ -148,7 +161,8 @@ class DerivationAssumptions:
         if omega0.free_symbols and not omega0.is_Symbol:
             assumptions.append(
                 _Assumption(
-                    f"omega0 = {omega0} > 0", lambda substitution: _numeric_sign(omega0.xreplace(substitution)) > 0, rederivable=False
+                    f"omega0 = {omega0} > 0", lambda substitution: _numeric_sign(omega0.xreplace(substitution)) > 0, rederivable=False,
+                    conditions=((omega0, _POSITIVE),),
                 )
             )
         if amplitude.free_symbols:
@@ -160,6 +174,7 @@ class DerivationAssumptions:
                         f"a0 = {amplitude} {relation} 0 (the side of the release point)",
                         lambda substitution: _numeric_sign(amplitude.xreplace(substitution)) == sign,
                         amplitude_sign=True,
+                        conditions=((amplitude, frozenset({sign})),),
                     )
                 )
             if not amplitude.is_nonzero:
@@ -168,6 +183,7 @@ class DerivationAssumptions:
                         "a0 != 0 (a0 = 0 is the rest state)",
                         lambda substitution: _numeric_sign(amplitude.xreplace(substitution)) != 0,
                         rederivable=False,
+                        conditions=((amplitude, _NONZERO),),
                     )
                 )
         if self.form.regime != "smooth":
@@ -192,17 +208,23 @@ class DerivationAssumptions:
             if kind == "crossing":
                 text = f"-{size} < {point} < {size} (contact: the orbit crosses the breakpoint u = {point})"
                 test = tests["crossing"]
+                conditions = ((kappa + 1, _POSITIVE), (kappa - 1, _NEGATIVE))
             elif kind == "above":
                 text = f"{point} > {size} (no contact: the breakpoint u = {point} is never reached)"
                 test = tests["above"]
+                conditions = ((kappa - 1, _POSITIVE),)
             elif kind == "below":
                 text = f"{point} < -{size} (permanent contact beyond the breakpoint u = {point})"
                 test = tests["below"]
+                conditions = ((kappa + 1, _NEGATIVE),)
             else:
                 target = 1 if sympy.simplify(kappa - 1) == 0 else -1
                 text = f"{point} = {target * size} (grazing: the breakpoint is a turning point)"
                 test = lambda value, target=target: _numeric_sign(value - target) == 0  # noqa: E731
-            assumptions.append(_Assumption(text, lambda substitution, kappa=kappa, test=test: test(kappa.xreplace(substitution))))
+                conditions = ((kappa - target, _ZERO),)
+            assumptions.append(
+                _Assumption(text, lambda substitution, kappa=kappa, test=test: test(kappa.xreplace(substitution)), conditions=conditions)
+            )
         if len(classes) > 1 and any(kappa.free_symbols for kappa, _ in classes):
             kappas = [kappa for kappa, _ in classes]
             points = " < ".join(str(sympy.simplify(form.amplitude_sign * kappa * amplitude)) for kappa in kappas)
@@ -212,9 +234,89 @@ class DerivationAssumptions:
                     lambda substitution: all(
                         _numeric_sign((right - left).xreplace(substitution)) > 0 for left, right in zip(kappas, kappas[1:])
                     ),
+                    conditions=tuple((right - left, _POSITIVE) for left, right in zip(kappas, kappas[1:])),
                 )
             )
         return assumptions
+
+    @cached_property
+    def _symbols(self) -> tuple[sympy.Symbol, ...]:
+        return tuple(sorted(self.problem.free_symbols, key=lambda symbol: symbol.name))
+
+    @cached_property
+    def _condition_rows(self) -> tuple[list[sympy.Expr], np.ndarray]:
+        """The expressions whose signs the assumptions test, and per expression its allowed signs as a
+        (rows, 3) table indexed by sign + 1."""
+        expressions, table = [], []
+        for assumption in self.assumptions:
+            for expression, signs in assumption.conditions:
+                expressions.append(expression)
+                table.append([sign in signs for sign in (-1, 0, 1)])
+        return expressions, np.array(table, dtype=bool).reshape(len(table), 3)
+
+    @property
+    def float_conditions(self) -> list[sympy.Expr]:
+        """The expressions whose signs :meth:`float_verdict` reads (compile them in the free symbols sorted by name)."""
+        return self._condition_rows[0]
+
+    def float_verdict(self, values: np.ndarray | None, bounds: np.ndarray | None, arrays: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray]:
+        """(violated, undecided) masks of the broadcast shape of ``arrays`` (one float or array per free symbol,
+        sorted by name), from the :attr:`float_conditions` evaluated in float64 with rounding ``bounds``.
+
+        A sign is decided where |value| exceeds its bound (or both are 0); an undecided element, or an
+        assumption without a float form, must be checked exactly with :meth:`check` (which words the error).
+        """
+        shape = np.broadcast_shapes(*[np.shape(value) for value in arrays]) if arrays else ()
+        violated = np.zeros(shape, dtype=bool)
+        undecided = np.zeros(shape, dtype=bool)
+        table = self._condition_rows[1]
+        if not shape and len(table) and not self._integers:  # one point: plain floats
+            failed = unknown = False
+            for value, bound, allowed in zip(values.tolist(), bounds.tolist(), table.tolist()):
+                if abs(value) > bound or (value == 0 and bound == 0):
+                    failed = failed or not allowed[(value > 0) - (value < 0) + 1]
+                else:
+                    unknown = True
+            return np.array(failed), np.array(unknown and not failed or self._inexpressible)
+        if len(table):
+            decided = (np.abs(values) > bounds) | ((values == 0) & (bounds == 0))  # False for NaN
+            signs = np.sign(np.where(decided, values, 0.0)).astype(np.int64) + 1
+            fits = table[np.arange(len(table)).reshape(-1, *[1] * len(shape)), signs]
+            violated = (decided & ~fits).any(axis=0)
+            undecided = (~decided).any(axis=0)
+        for symbol in self._integers:
+            violated = violated | np.broadcast_to(np.mod(arrays[self._symbols.index(symbol)], 1) != 0, shape)
+        if self._inexpressible:
+            undecided = np.ones(shape, dtype=bool)
+        return violated, undecided & ~violated
+
+    @cached_property
+    def _integers(self) -> tuple[sympy.Symbol, ...]:
+        return tuple(assumption.integer for assumption in self.assumptions if assumption.integer is not None)
+
+    @cached_property
+    def _inexpressible(self) -> bool:
+        """An assumption without a float form (checked exactly at every new value)."""
+        return any(not assumption.conditions and assumption.integer is None for assumption in self.assumptions)
+
+    def float_check(self, arrays: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`float_verdict` with the conditions compiled here.
+
+        Examples
+        --------
+        >>> import lindstedt, numpy as np
+        >>> e = lindstedt.expand("Max(0, u - b)", order=1, params={"b": None})   # a0, b, omega0
+        >>> violated, undecided = e._assumptions.float_check((1.0, np.array([0.5, 1.5, 1.0]), 1.0))
+        >>> violated.tolist(), undecided.tolist()    # b = a0 exactly: grazing, left to the exact check
+        ([False, True, False], [False, False, True])
+        """
+        expressions = self.float_conditions
+        family = compile_family(expressions, self._symbols) if expressions else None
+        if expressions and family is None:
+            shape = np.broadcast_shapes(*[np.shape(value) for value in arrays]) if arrays else ()
+            return np.zeros(shape, dtype=bool), np.ones(shape, dtype=bool)
+        values, bounds = family(*arrays) if family is not None else (None, None)
+        return self.float_verdict(values, bounds, arrays)
 
     def check(self, substitution: dict[sympy.Symbol, sympy.Expr]) -> dict[sympy.Symbol, sympy.Expr]:
         """Check numeric values (finite and real already: read by the parser) against the derivation's regime."""
