@@ -79,6 +79,8 @@ from sympy.polys.orderings import lex
 from sympy.polys.polyerrors import CoercionFailed
 from sympy.polys.rings import PolyElement, PolyRing
 
+from .cosine import power_by_squaring
+
 __all__ = ["ContactElement", "ContactField"]
 
 # Positional generator symbols (module-level Dummies: π, the i-th angle β_i, the i-th symbolic sine σ_i, the
@@ -545,14 +547,7 @@ class ContactElement:
             raise TypeError("ContactElement powers must be integers")
         if exponent < 0:
             return self.field._inverse(self) ** (-exponent)
-        result, base = self.field.one, self
-        while exponent:
-            if exponent & 1:
-                result = result * base
-            exponent >>= 1
-            if exponent:
-                base = base * base
-        return result
+        return power_by_squaring(self, exponent, self.field.one)
 
     def __repr__(self) -> str:
         return str(self.field.to_sympy(self))

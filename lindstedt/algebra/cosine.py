@@ -258,15 +258,7 @@ class CosineSeries(_TrigonometricSeries):
     def __pow__(self, exponent: int) -> "CosineSeries":
         if not isinstance(exponent, int) or exponent < 0:
             raise ValueError("CosineSeries powers must be non-negative integers")
-        result = CosineSeries.constant(self.domain, self.domain.one)
-        base = self
-        while exponent:
-            if exponent & 1:
-                result = result * base
-            exponent >>= 1
-            if exponent:
-                base = base * base
-        return result
+        return power_by_squaring(self, exponent, CosineSeries.constant(self.domain, self.domain.one))
 
     def second_derivative(self) -> "CosineSeries":
         """``d²/ds²``: multiplies ``c_n`` by ``−n²``."""
@@ -375,6 +367,18 @@ def solve_harmonic_oscillator(
             total = total + value
         particular[1] = value_at_zero - total
     return CosineSeries(domain, particular)
+
+
+def power_by_squaring(base: Any, exponent: int, one: Any) -> Any:
+    """``base ** exponent`` (exponent ≥ 0) by repeated squaring: ~2 log2(exponent) products."""
+    result = one
+    while exponent:
+        if exponent & 1:
+            result = result * base
+        exponent >>= 1
+        if exponent:
+            base = base * base
+    return result
 
 
 def sum_series(terms: Iterable[CosineSeries], domain: Any) -> CosineSeries:

@@ -61,13 +61,12 @@ import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
 from collections import OrderedDict
-from typing import Any, Callable, ClassVar, Mapping, NamedTuple
+from typing import Any, Callable, Mapping, NamedTuple
 
 import mpmath
 import numpy as np
 import sympy
 
-from ..export.json import JsonExport
 from .accuracy import (
     ExpansionValidityWarning,
     branch_bound,
@@ -87,9 +86,10 @@ from ..problems.parsing import parse_real
 from ..algebra.branch import Branch, EvaluationPoint
 from ..problems.oscillator import Oscillator, _decided_sign, reduce_quadratic
 from ..engine.branches import BranchHierarchy, FloatBranches
-from ..engine.stretched import FloatArc
 from ..engine.contact import PiecewiseNormalForm
 from ..engine.smooth import MAX_ORDER, NormalForm, SmoothHierarchy
+from ._waveform_data import _WAVEFORM_TOLERANCE, _WaveformData, _WaveformLayout
+from .stretched_arcs import STRETCHED_TIME, StretchedArcSeries
 
 __all__ = ["Expansion", "ExpansionValidityWarning", "Waveform", "PiecewiseWaveform", "STRAINED_TIME", "EPSILON", "TIME"]
 
@@ -247,113 +247,6 @@ class PiecewiseWaveform:
         }
 
 
-STRETCHED_TIME = sympy.Symbol("tau", nonnegative=True)
-
-
-def _chebyshev_sum(coefficients: list[Any], x: Any) -> Any:
-    """Σ_k c_k T_k(x) by Clenshaw's recurrence (mpmath numbers)."""
-    later, latest = 0, 0
-    for coefficient in reversed(coefficients[1:]):
-        later, latest = coefficient + 2 * x * later - latest, later
-    return coefficients[0] + x * later - latest
-
-
-@dataclass(frozen=True)
-class StretchedArcSeries(JsonExport):
-    """A contact arc with a non-polynomial law (Hertz, analytic), expanded in its own stretched time.
-
-    On the arc, ``u = sign · a0 · Σ_n ε̂^n Y_n(τ)`` with ``ε̂ = ε/ω0²`` (``gauge``'s variable),
-    ``τ = s/ℓ(ε)`` (``side = "release"``: the arc holds u(0); ``sign = +1``) or
-    ``τ = (π − s)/ℓ(ε)`` (``side = "far"``: the far turning point; ``sign = −1``), where
-    ``ℓ(ε) = Σ_n ℓ_n ε̂^n`` is the arc's half-length in strained time and
-    ``Y_n(τ) = Σ_k c_{n,k} T_k(2 (1 − τ)^{1/d} − 1)`` (Chebyshev polynomials T_k).  The
-    contact ends at τ = 1 for every ε, where Y = ``contact_point``.  ``mu`` are the
-    coefficients of μ = Ω²/ℓ², Ω = ω/ω0.  Numbers at the expansion's working precision.
-
-    Examples
-    --------
-    >>> import lindstedt
-    >>> arc = lindstedt.expand("Max(0, u)**(3/2)", order=1, a0=1, omega0=1, precision=20).stretched_arcs[0]
-    >>> arc.side, arc.denominator, round(float(arc.length[0]), 12)
-    ('release', 2, 1.570796326795)
-    """
-
-    SCHEMA: ClassVar[str] = "lindstedt.stretched-arc/1"
-
-    side: str
-    sign: int
-    denominator: int
-    exponent: str | None
-    contact_point: Any
-    length: tuple[Any, ...]
-    mu: tuple[Any, ...]
-    chebyshev: tuple[tuple[Any, ...], ...]
-    slope_chebyshev: tuple[tuple[Any, ...], ...]
-    digits: int
-
-    def fixed_s_derivative(self, strained_time: Any, order: int, times: int) -> Any:
-        """``[ε̂^order] ∂^times/∂s^times`` of the normalised displacement ``sign · Σ_n ε̂^n Y_n(τ(s))`` at an interior s.
-
-        Inside the arc (away from its moving end) the fixed-s expansion exists: it is what the phase
-        of an orbit that starts in contact needs.  Mixed derivatives by ``mpmath.diff`` on the series
-        truncated at ``order`` (exact through ε̂^order), at the arc's working precision.
-        """
-        if order >= len(self.chebyshev):
-            raise OrderError(f"the stretched arc is known through order {len(self.chebyshev) - 1}, not {order}")
-        with mpmath.workdps(self.digits + 15):
-            rows = [[mpmath.mpf(c) for c in row] for row in self.chebyshev[: order + 1]]
-            lengths = [mpmath.mpf(value) for value in self.length[: order + 1]]
-
-            def displacement(s: Any, scaled: Any) -> Any:
-                length = mpmath.polyval(lengths[::-1], scaled)
-                tau = (s if self.side == "release" else mpmath.pi - s) / length
-                x = 2 * (1 - tau) ** (mpmath.mpf(1) / self.denominator) - 1
-                total = mpmath.polyval([_chebyshev_sum(row, x) for row in rows][::-1], scaled)
-                return self.sign * total
-
-            value = mpmath.diff(displacement, (mpmath.mpf(strained_time), 0), (times, order)) / mpmath.factorial(order)
-        return +value
-
-    def value(self, tau: float, epsilon: float, omega0: float = 1.0) -> float:
-        """Σ_n ε̂^n Y_n(τ) in float arithmetic (the normalised displacement on the arc, before sign · a0)."""
-        values = [[float(c) for c in row] for row in self.chebyshev]
-        weights = (epsilon / omega0**2) ** np.arange(len(values))
-        return float(FloatArc(self.denominator, values, values).evaluate(np.asarray(tau, dtype=float), weights, False))
-
-    def to_latex(self) -> str:
-        """The representation on the arc, as a LaTeX sentence."""
-        variable = r"s/\ell(\varepsilon)" if self.side == "release" else r"(\pi - s)/\ell(\varepsilon)"
-        power = "" if self.exponent is None else rf", contact law $\propto |u - b|^{{{self.exponent}}}$"
-        sign = "" if self.sign > 0 else "-"
-        length = " + ".join(rf"{mpmath.nstr(value, 12)}\,\hat\varepsilon^{{{n}}}" for n, value in enumerate(self.length))
-        return (
-            rf"Stretched contact arc ({self.side} side{power}): $u = {sign}a_0 \sum_n \hat\varepsilon^n Y_n(\tau)$, "
-            rf"$\tau = {variable}$, $\hat\varepsilon = \varepsilon/\omega_0^2$, $\ell(\varepsilon) = {length} + \dots$, "
-            rf"$Y_n(\tau) = \sum_k c_{{n,k}} T_k\bigl(2 (1 - \tau)^{{1/{self.denominator}}} - 1\bigr)$ "
-            rf"({len(self.chebyshev[0])} Chebyshev coefficients per order, {self.digits} digits; see to_json)."
-        )
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready: every number as a decimal string at the working precision."""
-        def text(value: Any) -> str:
-            return mpmath.nstr(value, self.digits, min_fixed=-1, max_fixed=1) if not isinstance(value, str) else value
-
-        return {
-            "schema": self.SCHEMA,
-            "representation": "u = sign*a0*sum_n epsh**n * sum_k c[n][k]*T_k(2*(1 - tau)**(1/d) - 1), epsh = epsilon/omega0**2, "
-                              "tau = s/length (release side) or (pi - s)/length (far side), length = sum_n length[n]*epsh**n",
-            "side": self.side,
-            "sign": self.sign,
-            "d": self.denominator,
-            "exponent": self.exponent,
-            "contact_point": text(self.contact_point),
-            "length": [text(value) for value in self.length],
-            "mu": [text(value) for value in self.mu],
-            "chebyshev": [[text(value) for value in row] for row in self.chebyshev],
-            "slope_chebyshev": [[text(value) for value in row] for row in self.slope_chebyshev],
-        }
-
-
 def _series_power(coefficients: list[sympy.Expr], power: int, order: int) -> sympy.Expr:
     """The x^order coefficient of (Σ_{k≥1} coefficients[k] x^k)^power (coefficients[0] is ignored; missing ones
     are zero: for power ≥ 2 the x^order coefficient does not involve coefficients[order])."""
@@ -491,7 +384,6 @@ def _quadratic_field(problem: Oscillator) -> tuple[Callable, Callable, Callable]
 
 _COEFFICIENT_TOLERANCE = 1e-13  # relative rounding bound accepted for a compiled ω_k, φ_k
 _WARNING_TOLERANCE = 1e-3  # ... for ω_{N+1}, ω_{N+2} when only a warning reads them
-_WAVEFORM_TOLERANCE = 1e-13  # bound on |δu| / |a0| accepted from compiled waveform data
 _STABLE_AFTER = 4  # exact evaluations of one ω_k before its stable series is generated (≈ 0.1-0.4 s)
 _MEMORY = 64  # scalar parameter points whose float data an expansion keeps
 
@@ -523,143 +415,6 @@ def _horner(points: Any, coefficients: np.ndarray) -> Any:
     for coefficient in coefficients[-2::-1]:
         result = result * points + coefficient
     return result
-
-
-def _fold(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """s reduced to [0, π] by evenness and 2π-periodicity, and the sign of d/ds."""
-    shifted = np.mod(s + np.pi, 2 * np.pi) - np.pi
-    return np.abs(shifted), np.where(shifted < 0, -1.0, 1.0)
-
-
-def _terms(parity: int, frequency: np.ndarray, power: np.ndarray, coefficients: np.ndarray, s: np.ndarray, derivative: bool) -> np.ndarray:
-    """Σ_j c_j s^{m_j} trig(ν_j s) (trig = cos for parity 0, sin for 1) or its s-derivative; ``coefficients`` of
-    shape (K,) (one set) or (len(s), K) (one set per point)."""
-    argument = np.multiply.outer(s, frequency)
-    trig = np.cos(argument) if parity == 0 else np.sin(argument)
-    constant_power = not power.any()
-    powers = 1.0 if constant_power else np.power.outer(s, power)
-    if derivative:  # d/ds s^m trig(νs) = m s^{m−1} trig(νs) + ν s^m trig'(νs)
-        slope = (-np.sin(argument) if parity == 0 else np.cos(argument)) * frequency * powers
-        if not constant_power:
-            slope = slope + trig * np.where(power > 0, power * np.power.outer(s, np.maximum(power - 1, 0)), 0.0)
-        matrix = slope
-    else:
-        matrix = trig * powers
-    if coefficients.ndim == 1:
-        return matrix @ coefficients
-    return np.einsum("nk,nk->n", matrix, coefficients)
-
-
-@dataclass(frozen=True)
-class _WaveformData:
-    layout: "_WaveformLayout"
-    amplitude: Any  # a0, shape P
-    scale: Any  # ε̂/ε, shape P
-    shifts: np.ndarray  # (P..., orders, boundaries): β_i and σ_{i,n}
-    matrices: tuple[np.ndarray, ...]  # per block (P..., orders, keys)
-
-
-@dataclass(frozen=True)
-class _WaveformLayout:
-    """The displacement's float data as one flat vector: a0, ε̂/ε, the shifts σ_{i,n} (orders × boundaries), and
-    per (piece, parity) block the matrix of Σ_n ε̂^n Σ c s^m trig(ν s) (orders × (ν, m) keys); component 0 of
-    the engine's float branches (1 dof), summed term by term as FloatBranches does."""
-
-    orders: int
-    boundaries: int
-    pieces: int
-    blocks: tuple[tuple[int, int, np.ndarray, np.ndarray, int, int], ...]  # piece, parity, ν, m, offset, keys
-    expressions: tuple[Any, ...]
-    weights: np.ndarray  # (orders, entries): |∂W_n/∂value| bound per entry (s in [0, π]); 0 for a0 and ε̂/ε
-    family: Any  # BoundedFamily of the expressions (free symbols), or None
-    constants: np.ndarray | None  # the floats (no free symbols)
-
-    @staticmethod
-    def build(branches: FloatBranches, amplitude: Any, scale: Any, symbols: tuple[sympy.Symbol, ...]) -> "_WaveformLayout":
-        """From the engine's float branches (their values floats, or sympy expressions in ``symbols``)."""
-        terms, shifts = branches.terms, branches.shifts
-        orders, boundaries, pieces = len(terms), len(shifts[0]), len(terms[0])
-        numeric = not symbols
-        entries: list[Any] = [amplitude, scale]
-        weights = [np.zeros(orders), np.zeros(orders)]
-
-        def weight(n: int, value: float) -> np.ndarray:
-            row = np.zeros(orders)
-            row[n] = value
-            return row
-
-        for n in range(orders):
-            entries.extend(shifts[n])
-            weights.extend([weight(n, 1.0)] * boundaries)  # |u'| <= |a0| (1 + O(η̂)) where a boundary is misplaced
-        blocks = []
-        for piece in range(pieces):
-            for parity in (0, 1):
-                keys = sorted({(t[0], t[2]) for order in terms for t in order[piece][0] if t[1] == parity})
-                if not keys:
-                    continue
-                index = {key: position for position, key in enumerate(keys)}
-                matrix: list[list[Any]] = [[0.0 if numeric else sympy.Integer(0)] * len(keys) for _ in range(orders)]
-                for n, order in enumerate(terms):
-                    for frequency, term_parity, power, value in order[piece][0]:
-                        if term_parity == parity:
-                            matrix[n][index[frequency, power]] += value
-                frequencies, powers = (np.array(column, dtype=float) for column in zip(*keys))
-                blocks.append((piece, parity, frequencies, powers, len(entries), len(keys)))
-                for n, row in enumerate(matrix):
-                    entries.extend(row)
-                    # |s^m trig(ν s)| and its s-derivative on [0, π]
-                    weights.extend(weight(n, float(np.pi**m * (1 + nu + m))) for nu, m in keys)
-        table = np.array(weights).T  # (orders, entries)
-        if numeric:
-            return _WaveformLayout(orders, boundaries, pieces, tuple(blocks), tuple(entries), table, None, np.array(entries, dtype=float))
-        family = compile_family(entries, symbols)
-        return _WaveformLayout(orders, boundaries, pieces, tuple(blocks), tuple(entries), table, family, None)
-
-    def errors(self, values: np.ndarray, bounds: np.ndarray) -> np.ndarray:
-        """Per order n and parameter element: the bound on |δW_n| (u/a0 and its s-derivative) from rounding
-        in the compiled values; +inf where a0 or ε̂/ε is not within 1e-13 relative."""
-        with np.errstate(all="ignore"):  # an infinite bound (a value the closed form cannot give) stays infinite
-            errors = np.tensordot(self.weights, np.where(np.isfinite(bounds), bounds, np.inf), axes=1)  # (orders, P...)
-            errors = np.where(np.isnan(errors), np.inf, errors)
-            scaling = (bounds[:2] <= _WAVEFORM_TOLERANCE * np.abs(values[:2])).all(axis=0)
-        return np.where(scaling, errors, np.inf)
-
-    def unpack(self, values: np.ndarray) -> _WaveformData:
-        moved = np.moveaxis(values, 0, -1)  # P + (V,)
-        shape = moved.shape[:-1]
-        start = 2 + self.orders * self.boundaries
-        shifts = moved[..., 2:start].reshape(*shape, self.orders, self.boundaries)
-        matrices = tuple(moved[..., offset : offset + self.orders * keys].reshape(*shape, self.orders, keys) for *_, offset, keys in self.blocks)
-        return _WaveformData(self, moved[..., 0], moved[..., 1], shifts, matrices)
-
-    def evaluate(self, data: _WaveformData, strained: Any, scaled: Any, derivative: bool) -> np.ndarray:
-        """Σ_n η̂^n W_n(s) (or d/ds of it) at the strained times, between the moving contact angles."""
-        folded, sign = _fold(np.asarray(strained, dtype=float))
-        scaled = np.asarray(scaled, dtype=float)
-        weights = scaled[..., None] ** np.arange(self.orders)  # Q + (orders,)
-        result = np.zeros(folded.shape)
-        if not weights.shape[:-1] and not data.shifts.shape[:-2]:  # one ε, one parameter set: shared coefficients
-            index = np.searchsorted(weights @ data.shifts, folded) if self.pieces > 1 else None
-            for (piece, parity, frequencies, powers, _, _), matrix in zip(self.blocks, data.matrices):
-                mask = ... if index is None else index == piece
-                points = folded[mask]
-                if points.size:
-                    values = _terms(parity, frequencies, powers, weights @ matrix, points, derivative)
-                    result[mask] += values * sign[mask] if derivative else values
-            return result
-        full = folded.shape
-        index = None
-        if self.pieces > 1:
-            limits = np.einsum("...l,...lb->...b", weights, data.shifts)
-            index = (np.broadcast_to(limits, (*full, self.boundaries)) < folded[..., None]).sum(axis=-1)
-        for (piece, parity, frequencies, powers, _, keys), matrix in zip(self.blocks, data.matrices):
-            mask = np.ones(full, dtype=bool) if index is None else index == piece
-            if not mask.any():
-                continue
-            coefficients = np.broadcast_to(np.einsum("...l,...lk->...k", weights, matrix), (*full, keys))[mask]
-            values = _terms(parity, frequencies, powers, coefficients, folded[mask], derivative)
-            result[mask] += values * sign[mask] if derivative else values
-        return result
 
 
 @dataclass(frozen=True)
