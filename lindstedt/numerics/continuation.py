@@ -1012,6 +1012,7 @@ def nnm_sweep(
     parameter: str = "epsilon",
     epsilon: float | None = None,
     executor: Executor | None = None,
+    progress: bool | Callable[[int, float, NNMResult], Any] | None = None,
     **options: Any,
 ) -> list[NNMResult]:
     """NNM points at many parameter values, optionally in parallel; results in input order.
@@ -1030,7 +1031,12 @@ def nnm_sweep(
         energies (``"energy"``) or modal amplitudes (``"modal_amplitude"``) —
         then ``epsilon`` is fixed.
     executor : concurrent.futures.Executor, optional
-        Any executor (thread or process pool); default: serial in this thread.
+        Any executor: a thread or process pool, or a Dask cluster's
+        ``distributed.Client(...).get_executor()``; default: serial in this thread.
+    progress : bool or callable, optional
+        ``True``: a tqdm progress bar (warns, naming ``pip install tqdm``, when tqdm is
+        missing); a callable is called as ``progress(index, value, result)`` for every
+        point as it finishes (completion order with an executor).
     **options
         Passed to :func:`nnm_point` (``energy=``, ``formulation=``, ``tol=``, …).
 
@@ -1046,7 +1052,38 @@ def nnm_sweep(
     _check_parameter(parameter, epsilon, "sweeps")
     values = [float(v) for v in values]
     task = partial(_sweep_task, system=system, mode=mode, parameter=parameter, epsilon=epsilon, options=options)
-    if executor is None:
-        return [task(v) for v in values]
-    futures = [executor.submit(task, v) for v in values]
-    return [future.result() for future in futures]
+    report, close = _progress_reporter(progress, len(values))
+    results: list[NNMResult | None] = [None] * len(values)
+    try:
+        if executor is None:
+            for index, value in enumerate(values):
+                results[index] = task(value)
+                report(index, value, results[index])
+        else:
+            from concurrent.futures import as_completed
+
+            futures = {executor.submit(task, value): index for index, value in enumerate(values)}
+            for future in as_completed(futures):
+                index = futures[future]
+                results[index] = future.result()
+                report(index, values[index], results[index])
+    finally:
+        close()
+    return results  # type: ignore[return-value]  # every entry is filled
+
+
+def _progress_reporter(progress: Any, total: int) -> tuple[Callable[[int, float, NNMResult], Any], Callable[[], Any]]:
+    """(report, close) for :func:`nnm_sweep`'s ``progress``: nothing, a user callable, or a tqdm bar."""
+    if progress is None or progress is False:
+        return (lambda *_: None), (lambda: None)
+    if callable(progress):
+        return progress, (lambda: None)
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:
+        import warnings
+
+        warnings.warn("progress=True needs tqdm: pip install tqdm (no progress bar shown)", stacklevel=3)
+        return (lambda *_: None), (lambda: None)
+    bar = tqdm(total=total, desc="nnm_sweep", unit="point")
+    return (lambda *_: bar.update(1)), bar.close
