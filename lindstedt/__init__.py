@@ -9,6 +9,7 @@ The public API is re-exported here and in the documented public subpackages:
 * :mod:`lindstedt.algebra` — the exact algebra (cosine series, the contact Fourier
   kernel of ``(cos s − κ)_+`` and ``H(cos s − κ)``);
 * :mod:`lindstedt.numerics` — the exact piecewise-linear flow and NNMs by shooting;
+* :mod:`lindstedt.plot` — figures on matplotlib (backbone, waveform, spectra, convergence, NNM branches);
 * :mod:`lindstedt.cli` — the ``lindstedt`` command (``python -m lindstedt``).
 
 Behind the facade the package is laid out as the pipeline: ``problems/`` →

@@ -12,7 +12,7 @@ import lindstedt
 MODULES = sorted(
     name for _, name, _ in pkgutil.walk_packages(lindstedt.__path__, "lindstedt.") if not name.endswith("__main__")
 )
-PUBLIC_SUBPACKAGES = ("lindstedt.algebra", "lindstedt.numerics", "lindstedt.references", "lindstedt.validate")
+PUBLIC_SUBPACKAGES = ("lindstedt.algebra", "lindstedt.numerics", "lindstedt.plot", "lindstedt.references", "lindstedt.validate")
 
 
 @pytest.mark.parametrize("module_name", ["lindstedt", *MODULES])

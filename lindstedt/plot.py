@@ -1,0 +1,234 @@
+"""Plots of expansions against the truth, on matplotlib (optional: ``pip install 'lindstedt[plot]'``).
+
+Each function draws one standard figure of the field on a matplotlib ``Axes`` (a new figure when ``ax`` is
+None) and returns the Axes; the data drawn are those of the package's results and independent references:
+
+* :func:`backbone` — the frequency ω(a0) of ``u'' + ω0² u + ε f(u) = 0`` at orders 1…N of the Lindstedt–Poincaré
+  series against the exact frequency from the energy integral
+  (:func:`lindstedt.references.conservative_frequency`);
+* :func:`waveform` — the truncated expansion u_N(t) against the exact flow
+  (:func:`lindstedt.validate.reference_solution`: closed-form arcs for piecewise-linear f, DOP853 otherwise);
+* :func:`spectrum` — line spectra (:class:`lindstedt.Spectrum`), e.g. of the expansion and of the exact
+  solution side by side (seed fig. 2);
+* :func:`convergence` — max error against ε on log-log axes with the fitted slope
+  (:class:`lindstedt.validate.ConvergenceFit`);
+* :func:`branch` — an NNM branch (:class:`lindstedt.NNMBranch`): frequency against the continuation parameter,
+  stable points solid, unstable dashed, jumps across internal-resonance tongues marked.
+
+Examples
+--------
+>>> import matplotlib
+>>> matplotlib.use("Agg")
+>>> import lindstedt, lindstedt.plot
+>>> e = lindstedt.expand("Max(0, u)", order=2, a0=1, omega0=1)
+>>> ax = lindstedt.plot.waveform(e, 0.1, [0.0, 5.0, 10.0])
+>>> [line.get_label() for line in ax.get_lines()]
+['expansion, order 2', 'exact flow']
+"""
+
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as np
+
+from ._errors import LindstedtError
+
+__all__ = ["backbone", "branch", "convergence", "spectrum", "waveform"]
+
+
+def _axes(ax: Any) -> Any:
+    try:
+        import matplotlib.pyplot as plt
+    except ImportError as error:
+        raise LindstedtError("plotting needs matplotlib: pip install 'lindstedt[plot]'") from error
+    if ax is None:
+        _, ax = plt.subplots()
+    return ax
+
+
+def backbone(
+    f: Any,
+    amplitudes: Sequence[float],
+    epsilon: float,
+    *,
+    order: int = 3,
+    omega0: float = 1,
+    params: dict[str, Any] | None = None,
+    reference: bool = True,
+    ax: Any = None,
+) -> Any:
+    """ω(a0) at ε from the series truncated at orders 1…``order``, and the exact frequency.
+
+    Parameters
+    ----------
+    f : str or sympy expression
+        The nonlinearity, as for :func:`lindstedt.expand` (with ``params`` given values).
+    amplitudes : sequence of float
+        Release amplitudes a0 (u(0) = a0, u'(0) = 0).
+    epsilon : float
+        The small parameter.
+    order : int
+        Highest order drawn (one curve per order 1…order).
+    reference : bool
+        Also draw the exact frequency (energy-integral quadrature, 20 digits).
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import lindstedt.plot
+    >>> ax = lindstedt.plot.backbone("u**3", [0.5, 1.0], 0.1, order=2)
+    >>> [line.get_label() for line in ax.get_lines()]
+    ['order 1', 'order 2', 'exact']
+    """
+    import lindstedt
+    from lindstedt.references import conservative_frequency
+
+    ax = _axes(ax)
+    amplitudes = np.asarray(amplitudes, dtype=float)
+    series = [lindstedt.expand(f, order=order, a0=a0, omega0=omega0, params=params).omega for a0 in amplitudes]
+    for n in range(1, order + 1):
+        values = [sum(float(omega[k]) * epsilon**k for k in range(n + 1)) for omega in series]
+        ax.plot(amplitudes, values, label=f"order {n}")
+    if reference:
+        expression = lindstedt.Oscillator(f, a0=1, omega0=omega0, params=params).nonlinearity  # the one parser
+        exact = [float(conservative_frequency(expression, epsilon, a0=a0, omega0=omega0, precision=20)[0]) for a0 in amplitudes]
+        ax.plot(amplitudes, exact, "k--", label="exact")
+    ax.set_xlabel("amplitude $a_0$")
+    ax.set_ylabel(r"frequency $\omega$")
+    ax.set_title(rf"backbone at $\varepsilon = {epsilon:g}$")
+    ax.legend()
+    return ax
+
+
+def waveform(expansion: Any, epsilon: float, t: Sequence[float], *, values: dict[str, Any] | None = None,
+             reference: bool = True, ax: Any = None) -> Any:
+    """The expansion's displacement u_N(t) at ε and, with ``reference``, the exact flow's.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import lindstedt, lindstedt.plot
+    >>> ax = lindstedt.plot.waveform(lindstedt.expand("u**3", order=1, a0=1, omega0=1), 0.1, [0, 1, 2], reference=False)
+    >>> ax.get_lines()[0].get_label()
+    'expansion, order 1'
+    """
+    from lindstedt.validate import reference_solution
+
+    ax = _axes(ax)
+    times = np.asarray(t, dtype=float)
+    ax.plot(times, expansion.displacement(times, epsilon, values=values), label=f"expansion, order {expansion.order}")
+    if reference:
+        exact = reference_solution(expansion, epsilon, times, values=values)
+        if not exact.success:
+            raise LindstedtError(f"the exact flow failed: {exact.message}")
+        ax.plot(times, exact.displacement, "k--", label="exact flow")
+    ax.set_xlabel("time $t$")
+    ax.set_ylabel("displacement $u$")
+    ax.set_title(rf"$\varepsilon = {epsilon:g}$")
+    ax.legend()
+    return ax
+
+
+def spectrum(spectra: Any, *, labels: Sequence[str] | None = None, ax: Any = None) -> Any:
+    """Line spectra (one :class:`lindstedt.Spectrum` or several), amplitude on a log scale against ω.
+
+    Several spectra are drawn side by side (slightly offset in ω) so that their lines can be compared.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import lindstedt, lindstedt.plot
+    >>> from lindstedt.validate import expansion_spectrum
+    >>> e = lindstedt.expand("Max(0, u)", order=2, a0=1, omega0=1)
+    >>> ax = lindstedt.plot.spectrum(expansion_spectrum(e, 0.1), labels=["expansion"])
+    >>> ax.get_yscale()
+    'log'
+    """
+    ax = _axes(ax)
+    spectra = [spectra] if not isinstance(spectra, (list, tuple)) else list(spectra)
+    labels = list(labels) if labels is not None else [f"spectrum {i + 1}" for i in range(len(spectra))]
+    for index, (item, label) in enumerate(zip(spectra, labels)):
+        if not item.success:
+            raise LindstedtError(f"spectrum {label!r} failed: {item.message}")
+        frequencies = np.asarray(item.angular_frequencies, dtype=float)
+        amplitudes = np.asarray(item.amplitudes, dtype=float)
+        shown = amplitudes > 0
+        offset = 0.08 * item.fundamental * (index - (len(spectra) - 1) / 2)
+        ax.vlines(frequencies[shown] + offset, np.min(amplitudes[shown]) / 10, amplitudes[shown], colors=f"C{index}", label=label)
+    ax.set_yscale("log")
+    ax.set_xlabel(r"angular frequency $\omega$")
+    ax.set_ylabel("amplitude")
+    ax.legend()
+    return ax
+
+
+def convergence(fits: Any, *, labels: Sequence[str] | None = None, ax: Any = None) -> Any:
+    """Max error against ε (log-log) for one or several :class:`~lindstedt.validate.ConvergenceFit`, with the fitted line.
+
+    Each legend entry states the fitted slope and the expected one (N + 1 for a simple contact).
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import lindstedt, lindstedt.plot
+    >>> from lindstedt.validate import fitted_convergence_order
+    >>> fit = fitted_convergence_order(lindstedt.expand("u**3", order=1, a0=1, omega0=1), [0.01, 0.02, 0.04])
+    >>> ax = lindstedt.plot.convergence(fit)
+    >>> ax.get_xscale(), ax.get_yscale()
+    ('log', 'log')
+    """
+    ax = _axes(ax)
+    fits = [fits] if not isinstance(fits, (list, tuple)) else list(fits)
+    labels = list(labels) if labels is not None else [None] * len(fits)
+    for index, (fit, label) in enumerate(zip(fits, labels)):
+        epsilons, errors = np.asarray(fit.epsilons, dtype=float), np.asarray(fit.max_errors, dtype=float)
+        text = f"slope {fit.slope:.2f}" + (f" (expected {fit.expected_slope:g})" if fit.expected_slope is not None else "")
+        ax.loglog(epsilons, errors, "o", color=f"C{index}", label=f"{label}: {text}" if label else text)
+        ax.loglog(epsilons, np.exp(fit.intercept) * epsilons**fit.slope, "-", color=f"C{index}")
+    ax.set_xlabel(r"$\varepsilon$")
+    ax.set_ylabel(r"max error on $[0, T_\varepsilon]$")
+    ax.legend()
+    return ax
+
+
+def branch(nnm_branch: Any, *, ax: Any = None) -> Any:
+    """An NNM branch: frequency against the continuation parameter; stable solid, unstable dashed, jumps dotted.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import lindstedt, lindstedt.plot
+    >>> system = lindstedt.UnilateralSystem.one_dof(1)
+    >>> b = lindstedt.continue_nnm(system, 1, start=0.0, stop=0.5, modal_amplitude=1.0)
+    >>> ax = lindstedt.plot.branch(b)
+    >>> ax.get_xlabel()
+    'epsilon'
+    """
+    ax = _axes(ax)
+    values = np.asarray(nnm_branch.parameter_values, dtype=float)
+    frequencies = np.array([point.frequency for point in nnm_branch.points], dtype=float)
+    stable = np.array([bool(point.stable) for point in nnm_branch.points])
+    jumps = set(getattr(nnm_branch, "jumps", ()))
+    drawn: set[str] = set()
+    for k in range(len(values) - 1):
+        if k in jumps:
+            style, label = ":", "jump (resonance tongue)"
+        elif stable[k] and stable[k + 1]:
+            style, label = "-", "stable"
+        else:
+            style, label = "--", "unstable"
+        ax.plot(values[k : k + 2], frequencies[k : k + 2], style, color="C0", label=None if label in drawn else label)
+        drawn.add(label)
+    if len(values) == 1:
+        ax.plot(values, frequencies, "o", color="C0", label="stable" if stable[0] else "unstable")
+    ax.set_xlabel(nnm_branch.parameter)
+    ax.set_ylabel(r"frequency $\omega$")
+    ax.set_title(f"{'complete' if nnm_branch.success else 'stopped'}: {len(values)} points")
+    ax.legend()
+    return ax

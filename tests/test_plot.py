@@ -1,0 +1,98 @@
+"""lindstedt.plot draws the package's results and the independent references faithfully.
+
+References: the Duffing frequency from the complete elliptic integral (lindstedt.references.duffing_exact_frequency)
+for the backbone; the closed-form bilinear orbit of u'' + u + ε u_+ = 0 (two harmonic arcs, derived in the
+waveform test) for the waveform.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+matplotlib = pytest.importorskip("matplotlib")
+matplotlib.use("Agg")
+
+import lindstedt  # noqa: E402
+import lindstedt.plot  # noqa: E402
+from lindstedt.references import duffing_exact_frequency  # noqa: E402
+from lindstedt.validate import exact_spectrum, expansion_spectrum, fitted_convergence_order  # noqa: E402
+
+
+@pytest.fixture(autouse=True)
+def close_figures():
+    yield
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
+
+def test_backbone_draws_the_exact_duffing_frequency_and_orders_that_approach_it():
+    amplitudes, epsilon = [0.4, 0.8, 1.2], 0.1
+    ax = lindstedt.plot.backbone("u**3", amplitudes, epsilon, order=3)
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    assert list(lines) == ["order 1", "order 2", "order 3", "exact"]
+    exact = [float(duffing_exact_frequency(epsilon, amplitude=a, precision=30)) for a in amplitudes]
+    assert np.allclose(lines["exact"].get_ydata(), exact, rtol=1e-15)
+    errors = {n: np.abs(lines[f"order {n}"].get_ydata() - exact) for n in (1, 2, 3)}
+    assert np.all(errors[3] < errors[2]) and np.all(errors[2] < errors[1])
+
+
+def test_waveform_draws_the_closed_form_bilinear_orbit():
+    # u'' + u + ε u_+ = 0, u(0) = 1, u'(0) = 0: u = cos(k t) (k = √(1+ε)) until t₁ = π/(2k), where u' = −k;
+    # then u < 0 at frequency 1: u = −k sin(t − t₁), for t₁ ≤ t ≤ t₁ + π
+    epsilon = 0.3
+    k = math.sqrt(1 + epsilon)
+    t1 = math.pi / (2 * k)
+    times = np.linspace(0, t1 + math.pi, 41)
+    closed_form = np.where(times <= t1, np.cos(k * times), -k * np.sin(times - t1))
+    expansion = lindstedt.expand("Max(0, u)", order=2, a0=1, omega0=1)
+    ax = lindstedt.plot.waveform(expansion, epsilon, times)
+    expansion_line, exact_line = ax.get_lines()
+    assert np.allclose(exact_line.get_ydata(), closed_form, atol=1e-11)
+    assert np.allclose(expansion_line.get_ydata(), expansion.displacement(times, epsilon), rtol=0, atol=0)
+    assert np.max(np.abs(expansion_line.get_ydata() - closed_form)) < 0.05  # order 2 at ε = 0.3 over half a period
+
+
+def test_spectra_are_drawn_side_by_side_with_their_amplitudes():
+    expansion = lindstedt.expand("Max(0, u)", order=3, a0=1, omega0=1)
+    spectra = [expansion_spectrum(expansion, 0.2), exact_spectrum(expansion, 0.2)]
+    ax = lindstedt.plot.spectrum(spectra, labels=["expansion", "exact"])
+    assert ax.get_yscale() == "log"
+    collections = ax.collections
+    assert [c.get_label() for c in collections] == ["expansion", "exact"]
+    for collection, item in zip(collections, spectra):
+        tops = sorted(max(segment[:, 1]) for segment in collection.get_segments())
+        amplitudes = np.asarray(item.amplitudes, dtype=float)
+        assert np.allclose(tops, sorted(amplitudes[amplitudes > 0]))
+
+
+def test_convergence_draws_the_fitted_line_and_states_the_slope():
+    fit = fitted_convergence_order(lindstedt.expand("u**3", order=1, a0=1, omega0=1), [0.01, 0.02, 0.04])
+    ax = lindstedt.plot.convergence(fit, labels=["Duffing, N = 1"])
+    points, line = ax.get_lines()
+    assert np.allclose(points.get_ydata(), fit.max_errors)
+    assert np.allclose(line.get_ydata(), np.exp(fit.intercept) * np.asarray(fit.epsilons) ** fit.slope)
+    assert points.get_label() == f"Duffing, N = 1: slope {fit.slope:.2f} (expected {fit.expected_slope:g})"
+
+
+def test_branch_styles_follow_stability_and_jumps():
+    system = lindstedt.UnilateralSystem.one_dof(1)
+    result = lindstedt.continue_nnm(system, 1, start=0.0, stop=0.5, modal_amplitude=1.0)
+    ax = lindstedt.plot.branch(result)
+    segments = ax.get_lines()
+    assert len(segments) == len(result.points) - 1
+    for k, segment in enumerate(segments):
+        expected = ":" if k in result.jumps else ("-" if result.points[k].stable and result.points[k + 1].stable else "--")
+        assert segment.get_linestyle() == expected
+        assert np.allclose(segment.get_ydata(), [result.points[k].frequency, result.points[k + 1].frequency])
+
+
+def test_without_matplotlib_the_error_names_the_extra(monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "matplotlib.pyplot", None)
+    with pytest.raises(lindstedt.LindstedtError, match=r"pip install 'lindstedt\[plot\]'"):
+        lindstedt.plot.waveform(lindstedt.expand("u**3", order=1, a0=1, omega0=1), 0.1, [0.0, 1.0])
