@@ -85,7 +85,7 @@ def release_amplitudes_by_series(system: UnilateralSystem, mode: int, a0: Any, *
 
     Order one of mode k ≠ j: ``λ_j² v'' + λ_k² v = −Σ_i G_ki (a0 B_ij cos s − b_i)_+`` with the
     cosine coefficients of the contact functions from the Fourier kernel
-    (``(c cos s − b)_+ = |c| (±1)^l c_l[b/|c|]`` for ±c > 0), so
+    (``(c cos s − b)_+ = |c| (±1)^l c_l[b/|c|]`` for ±c > 0), so::
 
         a_k = v_k(0) = Σ_l F_{k,l} / (λ_k² − l² λ_j²),   F_{k,l} = −Σ_i G_ki |c_i| (sign c_i)^l c_l[b_i/|c_i|].
 

@@ -74,6 +74,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .._errors import ProblemError
+from ..export.display import format_number, format_vector, html_table, labelled_repr
 from ..export.json import JsonExport
 from ..problems.system import UnilateralSystem
 from .switching import _Bracket, _Counters, _first_exit, _SearchFailure
@@ -211,6 +212,47 @@ class FlowResult(JsonExport):
         n = positions.shape[-1]
         return positions.reshape(times.shape + (n,)), velocities.reshape(times.shape + (n,))
 
+    # -- display -----------------------------------------------------------------------------
+    def _display_rows(self, quoted: bool = True) -> list[tuple[str, str]]:
+        events = ", ".join(
+            f"t={format_number(e.time, 6)} spring {e.spring} {'on' if e.direction > 0 else 'off'}" for e in self.events[:3]
+        )
+        if len(self.events) > 3:
+            events += f", … ({len(self.events)} events; all in .events)"
+        return [
+            ("success", str(bool(self.success))),
+            ("message", repr(self.message) if quoted else self.message),
+            ("method", repr(self.method) if quoted else self.method),
+            ("t_final", format_number(self.t_final)),
+            ("position", format_vector(self.position)),
+            ("velocity", format_vector(self.velocity)),
+            ("events", f"[{events}]"),
+            ("n_switches", str(self.n_switches)),
+            ("n_root_solves", str(self.n_root_solves)),
+            ("n_arcs", str(self.n_arcs)),
+            ("n_evaluations", str(self.n_evaluations)),
+            ("n_decompositions", str(self.n_decompositions)),
+            ("contact_states", format_vector([str(list(state)) for state in self.contact_states], limit=6)
+             .replace("'", "")),
+        ]
+
+    def __repr__(self) -> str:
+        """Outcome, final state and cost counters; at most three events (``.events`` holds them all).
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> run = lindstedt.ExactFlow(lindstedt.UnilateralSystem.one_dof(1), 0.5).solve([1.0], [0.0], 10.0)
+        >>> text = repr(run)
+        >>> "success=True" in text and "n_switches=" in text and len(text) < 1500
+        True
+        """
+        return labelled_repr("FlowResult", self._display_rows())
+
+    def _repr_html_(self) -> str:
+        """Jupyter's rendering: a two-column table of :meth:`__repr__`'s fields."""
+        return html_table(f"FlowResult: {'success' if self.success else 'FAILED'}", self._display_rows(quoted=False))
+
 
 @dataclass(frozen=True)
 class FlowMapResult(JsonExport):
@@ -247,6 +289,28 @@ class FlowMapResult(JsonExport):
     n_evaluations: int
     system: UnilateralSystem | None = field(default=None, repr=False, compare=False)
     epsilon: float | None = field(default=None, repr=False, compare=False)
+
+    def _display_rows(self, quoted: bool = True) -> list[tuple[str, str]]:
+        sensitivity = "None" if self.sensitivity is None else f"<{self.sensitivity.shape[0]}x{self.sensitivity.shape[1]} matrix; see .sensitivity>"
+        return [
+            ("success", str(bool(self.success))),
+            ("message", repr(self.message) if quoted else self.message),
+            ("position", format_vector(self.position)),
+            ("velocity", format_vector(self.velocity)),
+            ("sensitivity", sensitivity),
+            ("n_switches", str(self.n_switches)),
+            ("n_root_solves", str(self.n_root_solves)),
+            ("n_arcs", str(self.n_arcs)),
+            ("n_evaluations", str(self.n_evaluations)),
+        ]
+
+    def __repr__(self) -> str:
+        """Outcome, state and cost counters; the sensitivity matrix by its shape."""
+        return labelled_repr("FlowMapResult", self._display_rows())
+
+    def _repr_html_(self) -> str:
+        """Jupyter's rendering: a two-column table of :meth:`__repr__`'s fields."""
+        return html_table(f"FlowMapResult: {'success' if self.success else 'FAILED'}", self._display_rows(quoted=False))
 
 
 # --------------------------------------------------------------------------- #

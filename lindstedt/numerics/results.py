@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from ..export.display import format_number, format_vector, html_grid, html_table, labelled_repr
 from ..export.json import JsonExport, finite_float, to_jsonable
 
 __all__ = ["ContinuationProgress", "NNMBranch", "NNMResult"]
@@ -183,6 +184,50 @@ class NNMResult(JsonExport):
             f"{self.newton_iterations} iterations, {self.flow_evaluations} flows"
         )
 
+    # -- display -----------------------------------------------------------------------------
+    def _display_rows(self, quoted: bool = True) -> list[tuple[str, str]]:
+        """(label, text) of the fields people read first: outcome, frequencies, release, stability, cost."""
+        largest = (
+            format_number(float(np.max(np.abs(self.floquet_multipliers))), 6) if self.floquet_multipliers is not None else "None"
+        )
+        return [
+            ("success", str(bool(self.success))),
+            ("message", repr(self.message) if quoted else self.message),
+            ("mode", str(self.mode)),
+            ("epsilon", format_number(self.epsilon)),
+            ("frequency", format_number(self.frequency)),
+            ("period", format_number(self.period)),
+            ("linear_frequency", format_number(self.linear_frequency)),
+            ("modal_amplitude", format_number(self.modal_amplitude)),
+            ("release_position", format_vector(self.release_position)),
+            ("energy", format_number(self.energy)),
+            ("stable", str(self.stable)),
+            ("max_abs_multiplier", largest),
+            ("residual", format_number(self.residual, 3)),
+            ("n_switches", str(self.n_switches)),
+            ("formulation", repr(self.formulation) if quoted else self.formulation),
+            ("newton_iterations", str(self.newton_iterations)),
+            ("flow_evaluations", str(self.flow_evaluations)),
+        ]
+
+    def __repr__(self) -> str:
+        """Labelled fields, numbers to 10 significant digits (the arrays are the fields themselves).
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> point = lindstedt.nnm_point(lindstedt.UnilateralSystem.one_dof(1), 3.0, 1, modal_amplitude=1.0)
+        >>> text = repr(point)
+        >>> "success=True" in text and "frequency=1.333333333" in text and len(text) < 1000
+        True
+        """
+        return labelled_repr("NNMResult", self._display_rows())
+
+    def _repr_html_(self) -> str:
+        """Jupyter's rendering: a two-column table of :meth:`__repr__`'s fields."""
+        state = "converged" if self.success else "FAILED"
+        return html_table(f"NNMResult: mode {self.mode}, {state}", self._display_rows(quoted=False))
+
 
 @dataclass(frozen=True)
 class ContinuationProgress(JsonExport):
@@ -212,6 +257,16 @@ class ContinuationProgress(JsonExport):
     result: NNMResult
     step: float
     flow_evaluations: int
+
+    def __repr__(self) -> str:
+        """Index, parameter, step and the point's frequency (the point itself is ``.result``)."""
+        return labelled_repr("ContinuationProgress", [
+            ("index", str(self.index)),
+            ("parameter", format_number(self.parameter)),
+            ("frequency", format_number(self.result.frequency)),
+            ("step", format_number(self.step, 4)),
+            ("flow_evaluations", str(self.flow_evaluations)),
+        ])
 
 
 @dataclass(frozen=True)
@@ -304,6 +359,76 @@ class NNMBranch(JsonExport):
     def stable(self) -> np.ndarray:
         """Stability flag at each point."""
         return np.array([bool(p.stable) for p in self.points])
+
+    # -- display -----------------------------------------------------------------------------
+    def _display_rows(self, quoted: bool = True) -> list[tuple[str, str]]:
+        """(label, text) of the branch as a whole: outcome, ranges, events, cost."""
+        def span(values: np.ndarray) -> str:
+            if not len(values):
+                return "[]"
+            return f"[{format_number(float(np.nanmin(values)))}, {format_number(float(np.nanmax(values)))}]"
+
+        def indices(values: tuple[int, ...]) -> str:
+            return format_vector(values, limit=10) if values else "()"
+
+        return [
+            ("success", str(bool(self.success))),
+            ("stop_reason", repr(self.stop_reason) if quoted else self.stop_reason),
+            ("method", repr(self.method) if quoted else self.method),
+            ("parameter", repr(self.parameter) if quoted else self.parameter),
+            ("points", str(len(self.points))),
+            ("parameter_range", span(np.asarray(self.parameter_values, dtype=float))),
+            ("frequency_range", span(self.frequencies)),
+            ("folds", indices(self.folds)),
+            ("stability_changes", indices(self.stability_changes)),
+            ("contact_changes", indices(self.contact_changes)),
+            ("jumps", indices(self.jumps)),
+            ("flow_evaluations", str(self.flow_evaluations)),
+            ("newton_iterations", str(self.newton_iterations)),
+            ("rejected_steps", str(self.rejected_steps)),
+            ("wall_time", f"{self.wall_time:.3g} s"),
+        ]
+
+    def __repr__(self) -> str:
+        """A summary (ranges, events, cost), never the points themselves (``.points``, ``.frequencies``…).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> branch = NNMBranch(True, "reached stop = 1", "natural", "epsilon", (), np.array([]), (), (), (), 4, 3, 0, 0.5)
+        >>> print(repr(branch).splitlines()[5:7])
+        ['  points=0,', '  parameter_range=[],']
+        """
+        return labelled_repr("NNMBranch", self._display_rows())
+
+    def _repr_html_(self, rows: int = 12) -> str:
+        """Jupyter's rendering: the summary table, then at most ``rows`` points (ends, events and evenly spaced)."""
+        summary = html_table(f"NNMBranch: {len(self.points)} points", self._display_rows(quoted=False))
+        if not self.points:
+            return summary
+        last = len(self.points) - 1
+        events = {k for group in (self.folds, self.stability_changes, self.contact_changes, self.jumps) for k in group}
+        chosen = set(sorted({0, last} | {k for k in events if k <= last})[:rows])
+        for k in np.linspace(0, last, rows).astype(int):
+            if len(chosen) >= rows:
+                break
+            chosen.add(int(k))
+        chosen_rows = sorted(chosen)
+        values = np.asarray(self.parameter_values, dtype=float)
+        table = [
+            [k, format_number(values[k]) if k < len(values) else "", format_number(p.epsilon), format_number(p.frequency),
+             format_number(p.energy, 6), p.stable, p.n_switches, "; ".join(
+                 name for name, group in (("fold", self.folds), ("stability change →", self.stability_changes),
+                                          ("contact change →", self.contact_changes), ("jump →", self.jumps)) if k in group)]
+            for k, p in ((k, self.points[k]) for k in chosen_rows)
+        ]
+        note = None if len(chosen_rows) == len(self.points) else (
+            f"{len(chosen_rows)} of {len(self.points)} points shown (ends, events, evenly spaced); all in .points"
+        )
+        points = html_grid(
+            "points", ["index", self.parameter, "ε", "ω", "energy", "stable", "switches", "event (→: before the next point)"], table, note=note
+        )
+        return summary + points
 
 
 def _branch_events(points: Sequence[NNMResult], values: Sequence[float]) -> tuple[tuple[int, ...], ...]:

@@ -57,11 +57,12 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
 from collections import OrderedDict
-from typing import Any, Callable, Mapping, NamedTuple
+from typing import Any, Callable, Mapping, NamedTuple, Sequence
 
 import mpmath
 import numpy as np
@@ -82,7 +83,8 @@ from .assumptions import DerivationAssumptions, shown_values
 from .._errors import OrderError, ParameterError, ProblemError, UnsupportedNonlinearityError
 from ..export.codegen import stable_function
 from ..export.stable import compile_family
-from ..problems.parsing import parse_real
+from ..problems.parsing import parse_expression, parse_real
+from ..export.display import jupyter_latex, labelled_repr, latex_text, shorten
 from ..algebra.branch import Branch, EvaluationPoint
 from ..problems.oscillator import Oscillator, _decided_sign, reduce_quadratic
 from ..engine.branches import BranchHierarchy, FloatBranches
@@ -106,6 +108,100 @@ _LATEX_NAMES = {"a0": "a_{0}", "omega0": r"\omega_{0}", "epsilon": r"\varepsilon
 def _latex(expression: sympy.Expr) -> str:
     names = {symbol: _LATEX_NAMES[symbol.name] for symbol in expression.free_symbols if symbol.name in _LATEX_NAMES}
     return sympy.latex(expression, symbol_names=names)
+
+
+def _equation_latex(problem: Oscillator) -> str:
+    r"""``\ddot u + ω0² u + ε f(u) = 0`` with a unit coefficient dropped and parentheses only where needed."""
+    u = sympy.Symbol("u")
+    stiffness = problem.omega0**2
+    if stiffness == 1:
+        linear = "u"
+    elif stiffness.is_Add:
+        linear = r"\left(" + _latex(stiffness) + r"\right) u"
+    else:
+        linear = _latex(stiffness) + " u"
+    force = problem.f.subs(problem.variable, u)
+    text = _latex(force)
+    if force.is_Add or force.could_extract_minus_sign():
+        text = r"\left(" + text + r"\right)"
+    return r"\ddot u + " + linear + r" + \varepsilon " + text + " = 0"
+
+
+def _initial_latex(problem: Oscillator) -> str:
+    if problem.has_initial_velocity:
+        return r"u(0) = " + _latex(problem.u0) + r",\ \dot u(0) = " + _latex(problem.v0)
+    if problem.normalization == "initial":
+        release = _latex(problem.a0) + ("" if problem.a1 == 0 else r" + \varepsilon " + _latex(problem.a1))
+        return r"u(0) = " + release + r",\ \dot u(0) = 0"
+    return r"\dot u(0) = 0,\ " + _latex(problem.a0) + r" = \text{first-harmonic amplitude}"
+
+
+_LONG_COEFFICIENT = 80  # LaTeX characters: a longer ω_k is written by its name in ω(ε)
+
+
+def _series_latex(coefficients: Sequence[sympy.Expr], gauge: sympy.Expr, names: Sequence[str] | None = None) -> str:
+    r"""Σ_k c_k gauge^k in increasing powers; with ``names``, if one c_k is long, every c_k (k ≥ 1) is written by its name.
+
+    >>> a0 = sympy.Symbol("a0", positive=True)
+    >>> _series_latex([a0, sympy.Rational(-1, 2), 0, a0 + 1], EPSILON)
+    'a_{0} - \\frac{\\varepsilon}{2} + \\left(a_{0} + 1\\right) \\varepsilon^{3}'
+    """
+    coefficients = [sympy.sympify(coefficient, strict=True) for coefficient in coefficients]
+    by_name = names is not None and any(len(_latex(c)) > _LONG_COEFFICIENT for c in coefficients)
+    terms: list[tuple[bool, str]] = []  # (negative, text of the magnitude)
+    for k, coefficient in enumerate(coefficients):
+        if coefficient == 0:
+            continue
+        power = gauge**k
+        if by_name and (k > 0 or len(_latex(coefficient)) > _LONG_COEFFICIENT):
+            text = names[k] + ("" if k == 0 else " " + _latex(power))
+            terms.append((False, text))
+        elif coefficient.is_Add:
+            text = r"\left(" + _latex(coefficient) + r"\right)"
+            terms.append((False, text if k == 0 else text + " " + _latex(power)))
+        elif coefficient.could_extract_minus_sign():
+            terms.append((True, _latex(-coefficient * power)))
+        else:
+            terms.append((False, _latex(coefficient * power)))
+    if not terms:
+        return "0"
+    negative, first = terms[0]
+    text = ("- " if negative else "") + first
+    for negative, term in terms[1:]:
+        text += (" - " if negative else " + ") + term
+    return text
+
+
+_RELATION = re.compile(r"\s(<=|>=|!=|<|>|=)\s")
+_RELATION_LATEX = {"<": "<", ">": ">", "=": "=", "<=": r"\le", ">=": r"\ge", "!=": r"\ne"}
+
+
+def _assumption_latex(text: str, symbols: Mapping[str, sympy.Symbol]) -> str:
+    r"""One assumption of :class:`DerivationAssumptions` (``"-a0 < b < a0 (contact: …)"``) as LaTeX.
+
+    The relation is read back through the package's whitelist parser and printed by sympy; the reason
+    in parentheses is kept as text, except the self-evident "is declared positive".  What cannot be
+    read is shown as text.
+
+    >>> a0, b = sympy.Symbol("a0", positive=True), sympy.Symbol("b", real=True)
+    >>> _assumption_latex("-a0 < b < a0 (contact: the orbit crosses u = b)", {"a0": a0, "b": b})
+    '- a_{0} < b < a_{0}\\ \\text{(contact: the orbit crosses u = b)}'
+    """
+    relation, _, reason = text.partition(" (")
+    reason = reason[:-1] if reason.endswith(")") else reason
+    pieces = _RELATION.split(relation)
+    try:
+        operands = [_latex(parse_expression(piece, symbols=symbols, what="assumption")) for piece in pieces[::2]]
+    except Exception:  # not a relation between expressions: keep the words
+        return r"\text{" + latex_text(text) + "}"
+    if len(operands) < 2:
+        return r"\text{" + latex_text(text) + "}"
+    latex = operands[0]
+    for operator, operand in zip(pieces[1::2], operands[1:]):
+        latex += f" {_RELATION_LATEX[operator]} {operand}"
+    if reason and "is declared" not in reason:
+        latex += r"\ \text{(" + latex_text(reason) + ")}"
+    return latex
 
 
 def _as_float(expression: sympy.Expr) -> float | None:
@@ -634,7 +730,7 @@ class Expansion:
 
         Zero for a release at rest.  From (u0, v0): ``v(φ; ε) = u0`` with the sign of
         ``u'(0) = ω v_s(φ) = v0``, i.e. ``φ_0 = atan2(−v0/ω0, u0)`` and φ_k from the Taylor
-        expansion of the waveforms at φ_0: with ψ = |φ| = ψ_0 + Δ, Δ = Σ_{k≥1} ψ_k gauge^k,
+        expansion of the waveforms at φ_0: with ψ = ``|φ|`` = ψ_0 + Δ, Δ = Σ_{k≥1} ψ_k gauge^k,
         ``Σ_{k,m} v_k^{(m)}(ψ_0) [Δ^m]_{n−k}/m! = 0`` at order n ≥ 1, which is linear in ψ_n
         through ``v_0'(ψ_0) = −|v0|/ω0``.  For piecewise f the branch of the piece that
         contains ψ_0 is used (its analytic continuation); if u0 sits on a crossed breakpoint
@@ -764,7 +860,7 @@ class Expansion:
         return self._omega_values(last, point).copy()
 
     def truncation_error_estimate(self, epsilon: Any, values: Mapping[Any, Any] | None = None, *, order: int | None = None) -> Any:
-        """|ω_{order+1} ε^{order+1}|: the size of the first neglected term of ω(ε) (vectorised).
+        """``|ω_{order+1} ε^{order+1}|``: the size of the first neglected term of ω(ε) (vectorised).
 
         Examples
         --------
@@ -782,7 +878,7 @@ class Expansion:
         return np.abs(coefficient * self._gauge_values(epsilon) ** (last + 1))
 
     def displacement_error_estimate(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None = None) -> np.ndarray:
-        """Estimated error of :meth:`displacement` at ``t`` (vectorised): the phase drift |a0| δω t, δω the terms of ω
+        """Estimated error of :meth:`displacement` at ``t`` (vectorised): the phase drift ``|a0| δω t``, δω the terms of ω
         after ω_{n+1} (which the displacement uses) through one more power of ε, plus the first neglected waveform
         term (the last kept one times η̂).
 
@@ -1284,7 +1380,7 @@ class Expansion:
         angles s_i*(ε) = β_i + Σ σ_{i,k} ε^k, so the error stays O(ε^{N+1}).
 
         The waveform coefficients are evaluated once per parameter values (compiled closed forms, accepted
-        where their rounding bound keeps u within 1e-13 |a0|, exact elsewhere); see :meth:`frequency`
+        where their rounding bound keeps u within ``1e-13 |a0|``, exact elsewhere); see :meth:`frequency`
         for how ``values`` are read.
 
         Examples
@@ -1376,31 +1472,41 @@ class Expansion:
         raise ValueError("quantity must be 'displacement' or 'frequency'")
 
     def to_latex(self, *, waveforms: bool = False) -> str:
-        """A LaTeX fragment (``align*``) with the equation, the ω_k and optionally the v_k.
+        r"""A LaTeX fragment (``align*``): the equation, what the derivation assumed, the ω_k, ω(ε), optionally the v_k.
 
-        Waveform LaTeX is built only when ``waveforms=True``.
+        Series are written in increasing powers of ε; a coefficient longer than a line is referred to
+        by its name ω_k in ω(ε) (its closed form is on its own line above).  The assumptions are those
+        :meth:`frequency` checks values against (the signs of the free symbols, the contact regime such
+        as ``|b| < a0`` for a gap b), plus the regime and validity time of a piecewise f.  Waveform LaTeX
+        is built only when ``waveforms=True``.
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> print(lindstedt.expand("u**3", order=2, a0=1, omega0=1).to_latex())  # doctest: +NORMALIZE_WHITESPACE
+        % lindstedt: u'' + u + eps*(u**3) = 0, u(0) = 1 [initial]
+        \begin{align*}
+        & \ddot u + u + \varepsilon u^{3} = 0,\quad u(0) = 1,\ \dot u(0) = 0 \\
+        \omega_{0} &= 1 \\
+        \omega_{1} &= \frac{3}{8} \\
+        \omega_{2} &= - \frac{21}{256} \\
+        \omega(\varepsilon) &= 1 + \frac{3 \varepsilon}{8} - \frac{21 \varepsilon^{2}}{256} + O(\varepsilon^{3})
+        \end{align*}
         """
         problem = self.problem
-        u = sympy.Symbol("u")
-        equation = (
-            r"\ddot u + " + _latex(problem.omega0**2) + r" u + \varepsilon\left(" + _latex(problem.f.subs(problem.variable, u)) + r"\right) = 0"
-        )
-        if problem.has_initial_velocity:
-            condition = r"u(0) = " + _latex(problem.u0) + r",\ \dot u(0) = " + _latex(problem.v0)
-        elif problem.normalization == "initial":
-            release = _latex(problem.a0) + ("" if problem.a1 == 0 else r" + \varepsilon " + _latex(problem.a1))
-            condition = r"u(0) = " + release + r",\ \dot u(0) = 0"
-        else:
-            condition = r"\dot u(0) = 0,\ " + _latex(problem.a0) + r" = \text{first-harmonic amplitude}"
-        lines = [r"& " + equation + r",\quad " + condition]
+        lines = [r"& " + _equation_latex(problem) + r",\quad " + _initial_latex(problem)]
+        assumptions = self._assumptions_latex()
+        if assumptions:
+            lines.append(r"& " + assumptions)
         for exponent, value in zip(self.exponents, self.omega):  # ω_{k/2} multiplies ε^{k/2} in the gauge sqrt(ε)
             lines.append(rf"\omega_{{{exponent}}} &= {_latex(value)}")
         remainder = rf" + O(\varepsilon^{{{_latex(sympy.Rational(self._steps * self.order + 1, self._steps))}}})"
-        lines.append(r"\omega(\varepsilon) &= " + _latex(self.frequency_expr()) + remainder)
+        names = [rf"\omega_{{{exponent}}}" for exponent in self.exponents]
+        lines.append(r"\omega(\varepsilon) &= " + _series_latex(self.omega, self.gauge, names) + remainder)
         if problem.has_initial_velocity:
             lines.append(r"u(t) &= v(\omega t + \varphi(\varepsilon); \varepsilon),\quad v(0; \varepsilon) = A(\varepsilon)")
-            lines.append(r"A(\varepsilon) &= " + _latex(self.amplitude_expr()) + remainder)
-            lines.append(r"\varphi(\varepsilon) &= " + _latex(self.phase_expr()) + remainder)
+            lines.append(r"A(\varepsilon) &= " + _series_latex(self.amplitude, self.gauge) + remainder)
+            lines.append(r"\varphi(\varepsilon) &= " + _series_latex(self.phase, self.gauge) + remainder)
         if waveforms:
             for waveform in self.waveforms:
                 lines.append(rf"v_{{{waveform.order}}}(s) &= {waveform.to_latex()}")
@@ -1409,6 +1515,35 @@ class Expansion:
         if waveforms and self.stretched_arcs:  # the arcs' own expansion, in stretched time
             body += "\n".join(arc.to_latex() for arc in self.stretched_arcs) + "\n"
         return body
+
+    def _assumptions_latex(self) -> str:
+        r"""``\text{assuming } …`` : the derivation's assumptions on free symbols and, for piecewise f, the regime."""
+        symbols = {symbol.name: symbol for symbol in self.problem.free_symbols}
+        parts = [_assumption_latex(assumption.text, symbols) for assumption in self._assumptions.assumptions]
+        text = r"\text{assuming } " + r",\ ".join(parts) if parts else ""
+        if self.is_piecewise:
+            regime = rf"\text{{regime: {latex_text(self.regime)}, valid for }} t = O(\varepsilon^{{{_latex(self.validity_exponent)}}})"
+            text = text + r";\quad " + regime if text else regime
+        return text
+
+    # -- display -----------------------------------------------------------------------------
+    def _repr_latex_(self) -> str:
+        """Jupyter's rendering: :meth:`to_latex` (without waveforms) as display math."""
+        return jupyter_latex(self.to_latex())
+
+    def __repr__(self) -> str:
+        """The problem, the order and ω_k (each cut to a few hundred characters; ``.omega[k]`` is the full one)."""
+        fields = [("problem", repr(self.problem.describe())), ("order", str(self.order))]
+        try:
+            if self._steps != 1:
+                fields.append(("gauge", str(self.gauge)))
+            omega = ", ".join(shorten(sympy.sstr(value), 160, f".omega[{k}]") for k, value in enumerate(self.omega))
+            fields.append(("omega", f"({omega})"))
+            if self.is_piecewise:
+                fields.append(("regime", repr(self.regime)))
+        except Exception as error:  # a repr never raises: show why the coefficients are missing
+            fields.append(("omega", f"<not available: {type(error).__name__}: {shorten(str(error), 120)}>"))
+        return labelled_repr("Expansion", fields, field_limit=1200)
 
     def to_dict(self, *, waveforms: bool = True) -> dict[str, Any]:
         """The documented JSON-ready dictionary (schema ``lindstedt.expansion/1``)."""

@@ -18,6 +18,7 @@ import mpmath
 import numpy as np
 import sympy
 
+from ..export.display import DIGITS, format_number, format_vector, jupyter_latex, labelled_repr
 from ..engine.branches import BranchHierarchy, FloatBranches, fold
 from .accuracy import (
     ExpansionValidityWarning,
@@ -63,7 +64,7 @@ class NNMExpansion:
         1: series in ε; 2: in ε^{1/2} — a grazing spring (touching its gap at a turning point
         of the linear mode) that the perturbed orbit passes makes ω(ε) non-analytic.
     small_divisors : tuple of (mode, harmonic, divisor)
-        Near-resonance report: |r_k² − n²| for the closest harmonic n of each mode k ≠ j;
+        Near-resonance report: ``|r_k² − n²|`` for the closest harmonic n of each mode k ≠ j;
         the amplification of mode k is ~1/divisor.
 
     Examples
@@ -138,7 +139,7 @@ class NNMExpansion:
         return np.polynomial.polynomial.polyval(eta, self._known_coefficients)
 
     def truncation_error_estimate(self, epsilon: Any) -> Any:
-        """|ω_{n+1} η^{n+1}|: the size of the first neglected term of ω(ε) (vectorised).
+        """``|ω_{n+1} η^{n+1}|``: the size of the first neglected term of ω(ε) (vectorised).
 
         The first call derives ω_{n+1}: order n + 1 of the hierarchy, which needs every W_{n,k} (O(N²) terms).
         """
@@ -146,7 +147,7 @@ class NNMExpansion:
 
     def displacement_error_estimate(self, t: Any, epsilon: float) -> np.ndarray:
         """Estimated error of :meth:`modal_displacement` at ``t`` (vectorised, the worst modal coordinate): the phase
-        drift |a0 ω_{n+1} η^{n+1}| t plus the first neglected waveform term (the last kept one times η̂).
+        drift ``|a0 ω_{n+1} η^{n+1}| t`` plus the first neglected waveform term (the last kept one times η̂).
         Derives ω_{n+1} on first use (see :meth:`truncation_error_estimate`).
 
         Examples
@@ -281,14 +282,70 @@ class NNMExpansion:
         return json.dumps(self.to_dict(), indent=indent, allow_nan=False)
 
     def to_latex(self) -> str:
-        """A LaTeX fragment with λ_j, ω_1, ω_2 and the a_k."""
-        lines = [rf"\lambda_{{{self.mode}}} &= {mpmath.nstr(self.omega[0], 15)}"]
+        r"""A LaTeX fragment (``align*``): λ_j, the ω_n, ω(ε) in increasing powers, the a_k and the validity.
+
+        Numbers to 15 significant digits (``to_dict()["omega_digits"]`` holds all working digits).
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> system = lindstedt.UnilateralSystem.one_dof(1, a=1, b=0)
+        >>> print(lindstedt.nnm(system, mode=1, a0=1, order=2).to_latex())
+        \begin{align*}
+        \lambda_{1} &= 1.0 \\
+        \omega_{1} &= 0.25 \\
+        \omega_{2} &= -0.125 \\
+        \omega(\varepsilon) &= 1.0 + 0.25\,\varepsilon - 0.125\,\varepsilon^{2} + O(\varepsilon^{3}) \\
+        & \text{release } u_{1}(0) = 1;\quad \text{springs: simple, valid for } t = O(\varepsilon^{-1})
+        \end{align*}
+        <BLANKLINE>
+        """
+        def number(value: Any) -> str:
+            return mpmath.nstr(value, 15)
+
+        lines = [rf"\lambda_{{{self.mode}}} &= {number(self.omega[0])}"]
+        series = number(self.omega[0])
         for n in range(1, len(self.omega)):  # ω_{n/gauge} multiplies ε^{n/gauge}
-            lines.append(rf"\omega_{{{sympy.Rational(n, self.gauge)}}} &= {mpmath.nstr(self.omega[n], 15)}")
+            exponent = sympy.Rational(n, self.gauge)
+            lines.append(rf"\omega_{{{exponent}}} &= {number(self.omega[n])}")
+            if self.omega[n] == 0:
+                continue
+            power = r"\varepsilon" if exponent == 1 else rf"\varepsilon^{{{sympy.latex(exponent)}}}"
+            series += (" - " if self.omega[n] < 0 else " + ") + number(abs(self.omega[n])) + r"\," + power
+        remainder = sympy.latex(sympy.Rational(len(self.omega), self.gauge))
+        lines.append(rf"\omega(\varepsilon) &= {series} + O(\varepsilon^{{{remainder}}})")
         for k, value in enumerate(self.release_modal):
             if k != self.mode - 1:
-                lines.append(rf"a_{{{k + 1}}} &= {mpmath.nstr(value, 15)}")
+                lines.append(rf"a_{{{k + 1}}} &= {number(value)}")
+        release = format_number(self.a0, 15) + ("" if self.a1 == 0 else rf" + {format_number(self.a1, 15)}\,\varepsilon")
+        validity = sympy.latex(self.validity_exponent)
+        lines.append(
+            rf"& \text{{release }} u_{{{self.mode}}}(0) = {release};\quad "
+            rf"\text{{springs: {', '.join(self.spring_roots)}, valid for }} t = O(\varepsilon^{{{validity}}})"
+        )
         return "\\begin{align*}\n" + " \\\\\n".join(lines) + "\n\\end{align*}\n"
+
+    def _repr_latex_(self) -> str:
+        """Jupyter's rendering: :meth:`to_latex` as display math."""
+        return jupyter_latex(self.to_latex())
+
+    def __repr__(self) -> str:
+        """Mode, release, order and the coefficients to 10 significant digits (``.omega`` holds the full ones)."""
+        fields = [
+            ("mode", str(self.mode)),
+            ("a0", format_number(self.a0)),
+            ("order", str(self.order)),
+            ("omega", format_vector(self.omega, DIGITS, limit=12)),
+            ("a_k", format_vector(self.a_k, DIGITS)),
+            ("lambdas", format_vector(self.lambdas, DIGITS)),
+            ("validity_exponent", str(self.validity_exponent)),
+            ("spring_roots", repr(self.spring_roots)),
+        ]
+        if self.a1:
+            fields.insert(2, ("a1", format_number(self.a1)))
+        if self.gauge != 1:
+            fields.append(("gauge", "sqrt(epsilon)"))
+        return labelled_repr("NNMExpansion", fields)
 
     def summary(self) -> str:
         """Plain-text summary."""

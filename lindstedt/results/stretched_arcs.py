@@ -17,6 +17,7 @@ import sympy
 
 from .._errors import OrderError
 from ..engine.stretched import FloatArc
+from ..export.display import DIGITS, format_number, format_vector, jupyter_latex, labelled_repr
 from ..export.json import JsonExport
 
 __all__ = ["STRETCHED_TIME", "StretchedArcSeries"]
@@ -100,13 +101,54 @@ class StretchedArcSeries(JsonExport):
         variable = r"s/\ell(\varepsilon)" if self.side == "release" else r"(\pi - s)/\ell(\varepsilon)"
         power = "" if self.exponent is None else rf", contact law $\propto |u - b|^{{{self.exponent}}}$"
         sign = "" if self.sign > 0 else "-"
-        length = " + ".join(rf"{mpmath.nstr(value, 12)}\,\hat\varepsilon^{{{n}}}" for n, value in enumerate(self.length))
+        length = ""
+        for n, value in enumerate(self.length):  # increasing powers of ε̂, signs folded into the joins
+            monomial = "" if n == 0 else r"\,\hat\varepsilon" if n == 1 else rf"\,\hat\varepsilon^{{{n}}}"
+            term = mpmath.nstr(abs(value), 12) + monomial
+            length += ("- " if value < 0 else "") + term if not length else (" - " if value < 0 else " + ") + term
         return (
             rf"Stretched contact arc ({self.side} side{power}): $u = {sign}a_0 \sum_n \hat\varepsilon^n Y_n(\tau)$, "
             rf"$\tau = {variable}$, $\hat\varepsilon = \varepsilon/\omega_0^2$, $\ell(\varepsilon) = {length} + \dots$, "
             rf"$Y_n(\tau) = \sum_k c_{{n,k}} T_k\bigl(2 (1 - \tau)^{{1/{self.denominator}}} - 1\bigr)$ "
             rf"({len(self.chebyshev[0])} Chebyshev coefficients per order, {self.digits} digits; see to_json)."
         )
+
+    def _repr_latex_(self) -> str:
+        """Jupyter's rendering: the :meth:`to_latex` sentence (inline math)."""
+        return jupyter_latex(self.to_latex())
+
+    def __repr__(self) -> str:
+        """The arc's side, law and lengths to 10 digits; the Chebyshev tables by their size (``.chebyshev`` holds them).
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> arc = lindstedt.expand("Max(0, u)**(3/2)", order=1, a0=1, omega0=1, precision=20).stretched_arcs[0]
+        >>> print(repr(arc))
+        StretchedArcSeries(
+          side='release',
+          sign=1,
+          d=2,
+          exponent='3/2',
+          contact_point=0.0,
+          length=[1.570796327, -0.3594420704],
+          mu=[0.4052847346, 0.3709618659],
+          chebyshev=<2 orders x 64 coefficients; see .chebyshev>,
+          digits=20,
+        )
+        """
+        orders, size = len(self.chebyshev), len(self.chebyshev[0]) if self.chebyshev else 0
+        return labelled_repr("StretchedArcSeries", [
+            ("side", repr(self.side)),
+            ("sign", str(self.sign)),
+            ("d", str(self.denominator)),
+            ("exponent", repr(self.exponent)),
+            ("contact_point", format_number(self.contact_point)),
+            ("length", format_vector(self.length, DIGITS)),
+            ("mu", format_vector(self.mu, DIGITS)),
+            ("chebyshev", f"<{orders} orders x {size} coefficients; see .chebyshev>"),
+            ("digits", str(self.digits)),
+        ])
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready: every number as a decimal string at the working precision."""
