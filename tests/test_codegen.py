@@ -46,7 +46,7 @@ def test_bad_arguments():
     with pytest.raises(ValueError, match="quantity"):
         lindstedt.generate_code(expansion, "energy")
     with pytest.raises(ValueError, match="language"):
-        lindstedt.generate_code(expansion, "frequency", "fortran")
+        lindstedt.generate_code(expansion, "frequency", "cobol")
 
 
 @pytest.mark.parametrize("language", LANGUAGES)

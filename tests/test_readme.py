@@ -54,3 +54,36 @@ def test_readme_command_runs_literally(command, tmp_path):
     result = subprocess.run(shlex.split(command), cwd=tmp_path, capture_output=True, text=True, timeout=300, check=False)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip()
+
+
+def readme_console_blocks() -> list[tuple[str, str]]:
+    """The README's ```console blocks: `$ lindstedt …` and the output it prints."""
+    text = README.read_text(encoding="utf-8")
+    blocks = []
+    for block in re.findall(r"```console\n(.*?)```", text, flags=re.S):
+        first, _, output = block.partition("\n")
+        assert first.startswith("$ lindstedt "), first
+        blocks.append((first[2:], output))
+    return blocks
+
+
+def test_readme_shows_pretty_output_and_eps():
+    blocks = readme_console_blocks()
+    assert any("--eps" in command and "ω" in output and "ε" in output for command, output in blocks)
+
+
+@pytest.mark.parametrize("command, shown", readme_console_blocks())
+def test_readme_console_output_is_what_the_command_prints(command, shown):
+    result = subprocess.run(shlex.split(command), cwd=README.parent, capture_output=True, text=True, timeout=300, check=False)
+    assert result.returncode == 0, result.stderr
+
+    def lines(text):
+        return [line.rstrip() for line in text.strip("\n").splitlines()]
+
+    assert lines(result.stdout) == lines(shown)
+
+
+def test_readme_states_the_measured_test_time_and_a_venv():
+    text = README.read_text(encoding="utf-8")
+    assert "python3 -m venv .venv" in text
+    assert re.search(r"`pytest` took \d+(\.\d+)? min", text)

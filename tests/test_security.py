@@ -171,10 +171,11 @@ def test_cli_failures_are_one_error_line_and_exit_2(argv, fragment, capsys):
     assert err.startswith("error: ") and err.count("\n") == 1 and fragment in err
 
 
-def test_cli_nnm_eps_without_numeric_is_an_error(tmp_path, capsys):
+def test_cli_nnm_energy_without_numeric_is_an_error(tmp_path, capsys):
+    # an energy amplitude belongs to shooting (--numeric); the expansion takes --a0 (--eps then evaluates it)
     system = tmp_path / "system.json"
     system.write_text(json.dumps({"M": [[1]], "K": [[1]], "A": [[1]], "b": [0]}))
-    status, _, err, _ = run_cli(["nnm", str(system), "--mode", "1", "--a0", "1", "--eps", "0.1"], capsys)
+    status, _, err, _ = run_cli(["nnm", str(system), "--mode", "1", "--energy", "0.5", "--eps", "0.1"], capsys)
     assert status == 2 and "--numeric" in err
 
 

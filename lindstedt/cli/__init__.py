@@ -3,17 +3,20 @@
 Sub-commands
 ------------
 ``lindstedt expand F --order N [--a0 A] [--omega0 W] [--param NAME=VALUE ...]
-[--normalization initial|harmonic] [--format text|latex|json]``
-    Lindstedt–Poincaré expansion of the oscillator with nonlinearity F.
+[--normalization initial|harmonic] [--eps E] [--format pretty|plain|latex|json]``
+    Lindstedt–Poincaré expansion of the oscillator with nonlinearity F; ``--eps E`` also
+    prints ω(E) evaluated from the expansion.  Text output is pretty (Unicode, 2-D
+    formulas) by default; ``--format plain`` (alias ``text``) prints Python syntax.
     ``--u0 U --v0 V`` instead of ``--a0``: the orbit through u(0) = U, u'(0) = V
     (its turning-point and phase series are printed too).
-``lindstedt nnm SYSTEM.json --mode J --a0 A [--order 2] [--format text|latex|json]``
-    Nonlinear normal mode of M X'' + K X + ε W (A X − b)_+ = 0 grown from mode J.
+``lindstedt nnm SYSTEM.json --mode J --a0 A [--order 2] [--eps E] [--format pretty|plain|latex|json]``
+    Nonlinear normal mode of M X'' + K X + ε W (A X − b)_+ = 0 grown from mode J
+    (``--eps E``: and the expansion's frequency at ε = E).
 ``lindstedt nnm SYSTEM.json --mode J --numeric (--a0 A | --energy E) --eps EPS [--format json]``
     The same NNM by shooting on the exact flow: frequency, period, release state, Floquet multipliers.
 ``lindstedt derive NAME [--order N] [--format text|latex|json] [--output DIR]`` / ``lindstedt derive --list``
     Named derivations (Duffing, u_+, gaps, grazing, NNMs, all modes).
-``lindstedt demo``
+``lindstedt demo [--figure PATH]``
     The tour: derives the Duffing and unilateral-spring expansions, prints them
     and their agreement with the exact references.
 
@@ -22,6 +25,8 @@ non-zero: 2 for bad input (arguments, files, values outside what a method takes)
 1 for a computation that failed (a numerical method that did not converge, an
 unexpected internal error).  JSON output never contains NaN or infinities: a
 failed numerical result has ``null`` values with ``"success": false`` and a message.
+A validity warning of an evaluated expansion (``--eps``) is one line ``warning: …`` on stderr.
+Nothing is written to disk unless asked (``derive --output DIR``, ``demo --figure PATH``).
 """
 
 from __future__ import annotations
@@ -36,6 +41,12 @@ __all__ = ["main", "build_parser"]
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILED = 1
+
+FORMATS = ("pretty", "plain", "text", "latex", "json")
+FORMAT_HELP = (
+    "pretty: Unicode 2-D formulas (default); plain: Python syntax, one formula a line "
+    "(text is an alias of plain); latex: an align* block; json: the documented schema"
+)
 
 
 class _InputError(Exception):
@@ -66,8 +77,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="lindstedt",
         description="Exact Lindstedt-Poincare expansions of u'' + omega0^2 u + eps f(u) = 0, checked against exact references.",
     )
-    parser.add_argument("--version", action="version", version=f"lindstedt {__version__}")
-    commands = parser.add_subparsers(dest="command", required=True, parser_class=_ArgumentParser)
+    parser.add_argument("--version", action="version", version=f"lindstedt {__version__}", help="print the version and exit")
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=_ArgumentParser, metavar="COMMAND",
+                                     help="expand, nnm, derive or demo (lindstedt COMMAND --help for its options)")
 
     expand = commands.add_parser("expand", help="expand u'' + omega0^2 u + eps f(u) = 0 to a given order")
     expand.add_argument("f", help="the nonlinearity f(u), e.g. 'u**3' or 'u**3 + c*u**5'")
@@ -87,7 +99,9 @@ def build_parser() -> argparse.ArgumentParser:
     expand.add_argument("--u0", default=None, help="initial displacement u(0) (with --v0; instead of --a0)")
     expand.add_argument("--v0", default=None,
                         help="initial velocity u'(0): the orbit through (u0, v0), with its turning-point and phase series")
-    expand.add_argument("--format", choices=("text", "latex", "json"), default="text")
+    expand.add_argument("--eps", default=None, metavar="E",
+                        help="also print omega(E), the expansion's frequency at eps = E (needs numeric --a0, --omega0 and parameter values)")
+    expand.add_argument("--format", choices=FORMATS, default="pretty", help=FORMAT_HELP)
     expand.add_argument("--waveforms", action="store_true", help="include the waveforms v_k in text/LaTeX output")
     expand.add_argument("--precision", type=int, default=30, help="decimal digits for non-polynomial f (default 30)")
 
@@ -97,10 +111,11 @@ def build_parser() -> argparse.ArgumentParser:
     nnm.add_argument("--a0", default=None, help="modal amplitude of mode j at release (expansion, or --numeric with the other modal coordinates free)")
     nnm.add_argument("--numeric", action="store_true", help="periodic orbit by shooting on the exact flow instead of the expansion")
     nnm.add_argument("--energy", default=None, help="with --numeric: prescribed energy instead of --a0")
-    nnm.add_argument("--eps", default=None, help="with --numeric: the value of epsilon")
+    nnm.add_argument("--eps", default=None, metavar="E",
+                     help="the value of epsilon: the expansion's frequency at E, or with --numeric the orbit at E (required there)")
     nnm.add_argument("--order", type=int, default=2, help="expansion order (default 2)")
     nnm.add_argument("--precision", type=int, default=30, help="decimal digits of the arithmetic (default 30)")
-    nnm.add_argument("--format", choices=("text", "latex", "json"), default="text")
+    nnm.add_argument("--format", choices=FORMATS, default="pretty", help=FORMAT_HELP + " (--numeric: pretty, plain and latex print its summary)")
 
     derive = commands.add_parser(
         "derive", help="run a worked example of the source tree's derivations/ (LaTeX fragment + JSON coefficients)"
@@ -108,13 +123,14 @@ def build_parser() -> argparse.ArgumentParser:
     derive.add_argument("name", nargs="?", help="derivation name: the script derivations/NAME.py (see --list)")
     derive.add_argument("--list", action="store_true", help="list the scripts in derivations/ with their first docstring line")
     derive.add_argument("--order", type=int, default=None, help="expansion order (default: the script's own)")
-    derive.add_argument("--format", choices=("text", "latex", "json"), default="text",
-                        help="print the coefficients and checks (text), the LaTeX fragment or the JSON (default text)")
+    derive.add_argument("--format", choices=("text", "plain", "latex", "json"), default="text",
+                        help="print the coefficients and checks (text, alias plain), the LaTeX fragment or the JSON (default text)")
     derive.add_argument("--output", default=None, help="directory to write NAME.tex and NAME.json into (default: write nothing)")
 
     demo = commands.add_parser("demo", help="the tour: Duffing and u_+ expansions checked against exact references")
     demo.add_argument("--order", type=int, default=8, help="Duffing order to derive (default 8)")
-    demo.add_argument("--figure", default="lindstedt-demo.svg", help="where to write the SVG figure (default lindstedt-demo.svg; '' for none)")
+    demo.add_argument("--figure", default=None, metavar="PATH",
+                      help="also write an SVG figure of the error of orders 0-2 to PATH, e.g. lindstedt-demo.svg (default: write nothing)")
     return parser
 
 
@@ -133,14 +149,142 @@ def _command_expand(arguments: argparse.Namespace) -> str:
         u0=arguments.u0,
         v0=arguments.v0,
     )
+    evaluated = None if arguments.eps is None else _evaluate_expansion(expansion, arguments.eps)
     if arguments.format == "json":
-        return expansion.to_json()
+        if evaluated is None:
+            return expansion.to_json()
+        import json
+
+        data = expansion.to_dict()
+        data["evaluated"] = {"epsilon": evaluated[0], "omega": evaluated[1]}
+        return json.dumps(data, indent=2, allow_nan=False)
     if arguments.format == "latex":
-        return expansion.to_latex(waveforms=arguments.waveforms)
+        text = expansion.to_latex(waveforms=arguments.waveforms)
+        if evaluated is not None:
+            text = text.rstrip("\n") + f"\n\\[ \\omega({evaluated[0]!r}) \\approx {evaluated[1]!r} \\]"
+        return text
+    if arguments.format == "pretty":
+        text = _pretty_expansion(expansion, waveforms=arguments.waveforms)
+        if evaluated is not None:
+            text += f"\nω(ε = {evaluated[0]!r}) = {evaluated[1]!r}"
+        return text
     text = expansion.summary()
     if arguments.waveforms:
         text += "\n" + "\n".join(f"  v_{w.order}(s) = {w.to_expr()}" for w in expansion.waveforms)
+    if evaluated is not None:
+        text += f"\nomega({evaluated[0]!r}) = {evaluated[1]!r}"
     return text
+
+
+def _pretty(expression: Any) -> str:
+    import sympy
+
+    return sympy.pretty(expression, use_unicode=True, order="none")
+
+
+def _pretty_equation(name: Any, value: Any) -> str:
+    """``name = value`` in 2-D Unicode (``omega_1`` prints as ω₁, ``a0`` as a₀, ``epsilon`` as ε)."""
+    import sympy
+
+    left = sympy.Symbol(name) if isinstance(name, str) else name
+    return _pretty(sympy.Eq(left, sympy.sympify(value, strict=True), evaluate=False))
+
+
+def _pretty_expansion(expansion: Any, *, waveforms: bool = False) -> str:
+    """The default text output of ``expand``: the problem and ω_0..ω_N (and more) as Unicode 2-D formulas."""
+    import sympy
+
+    problem = expansion.problem
+    u, epsilon = sympy.Symbol("u"), sympy.Symbol("epsilon")
+    stiffness = u if problem.omega0 == 1 else sympy.Mul(problem.omega0**2, u, evaluate=False)
+    equation = sympy.Add(sympy.Symbol("u''"), stiffness, sympy.Mul(epsilon, problem.f, evaluate=False), evaluate=False)
+    blocks = [_pretty(sympy.Eq(equation, 0, evaluate=False))]
+    if problem.has_initial_velocity:
+        blocks.append(_pretty_equation("u(0)", problem.u0))
+        blocks.append(_pretty_equation("u'(0)", problem.v0) + "   (released off the turning point a₀ + O(ε))")
+    else:
+        release = problem.a0 if problem.a1 == 0 else sympy.Add(problem.a0, problem.a1 * epsilon, evaluate=False)
+        blocks.append(_pretty_equation("u(0)", release) + f"   u'(0) = 0   [{problem.normalization} normalization]")
+    for symbol, value in problem.params:
+        if value != symbol:
+            blocks.append(_pretty_equation(symbol, value))
+    if problem.symbolic_parameters:
+        blocks.append("symbolic: " + ", ".join(_pretty(symbol) for symbol in problem.symbolic_parameters))
+    terms = len(expansion.omega)
+    if isinstance(expansion.gauge, sympy.Symbol):
+        series = " + ".join(["ω₀", "ω₁·ε"][:terms] + [f"ω{_subscript(k)}·ε{_superscript(k)}" for k in range(2, terms)])
+        blocks.append(f"ω(ε) = {series} + O(ε{_superscript(terms)})")
+    else:
+        blocks.append(f"ω(ε) = Σₖ ωₖ·({_pretty(expansion.gauge)})ᵏ   (grazing: not analytic in ε)")
+    blocks += [_pretty_equation(f"omega_{k}", value) for k, value in enumerate(expansion.omega)]
+    if problem.has_initial_velocity:
+        blocks.append("u(t) = v(ω·t + φ(ε); ε), released at the turning point A(ε) = v(0; ε) > 0")
+        blocks += [_pretty_equation(f"A_{k}", value) for k, value in enumerate(expansion.amplitude)]
+        blocks += [_pretty_equation(f"phi_{k}", value) for k, value in enumerate(expansion.phase)]
+    if waveforms:
+        s = sympy.Symbol("s")
+        blocks += [_pretty_equation(sympy.Function(f"v_{w.order}")(s), w.to_expr()) for w in expansion.waveforms]
+    return "\n".join(blocks)
+
+
+def _pretty_nnm(result: Any) -> str:
+    """The default text output of ``nnm``: the summary with Unicode symbols."""
+    import mpmath
+
+    lines = [f"NNM of mode {result.mode} (a₀ = {result.a0}), strained coordinates to order {result.order}"]
+    lines.append("  λ = " + ", ".join(f"{value:.10g}" for value in result.lambdas))
+    lines += [f"  ω{_subscript(n)} = {mpmath.nstr(value, 15)}" for n, value in enumerate(result.omega)]
+    lines.append("  aₖ = " + ", ".join(mpmath.nstr(value, 12) for value in result.a_k) + "   (release uₖ(0) = ε·aₖ)")
+    lines.append(f"  validity: T ~ ε^({result.validity_exponent}); spring roots: {', '.join(result.spring_roots)}")
+    return "\n".join(lines)
+
+
+def _superscript(number: int) -> str:
+    return "" if number == 1 else str(number).translate(str.maketrans("0123456789", "⁰¹²³⁴⁵⁶⁷⁸⁹"))
+
+
+def _subscript(number: int) -> str:
+    return str(number).translate(str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉"))
+
+
+def _evaluate_expansion(expansion: Any, eps_text: str) -> tuple[float, float]:
+    """(ε, ω(ε)) from the expansion; its validity warnings become one ``warning:`` line on stderr."""
+    from ..problems.parsing import parse_float
+
+    epsilon = parse_float(eps_text, what="--eps")
+    problem = getattr(expansion, "problem", None)
+    if problem is not None:
+        free = sorted(str(symbol) for symbol in _free_symbols(problem))
+        if free:
+            raise ProblemError(
+                f"--eps evaluates the expansion, which needs numbers for {', '.join(free)}: "
+                "give --a0 A and --omega0 W as numbers and every --param as NAME=VALUE"
+            )
+    return epsilon, _warned(lambda: float(expansion.frequency(epsilon)))
+
+
+def _free_symbols(problem: Any) -> set:
+    symbols = set(problem.symbolic_parameters)
+    for value in (problem.a0, problem.omega0, problem.a1):
+        symbols |= set(getattr(value, "free_symbols", ()))
+    return symbols
+
+
+def _warned(compute: Any) -> Any:
+    """Run ``compute()``; an ExpansionValidityWarning it raises is printed as one ``warning:`` line on stderr."""
+    import warnings
+
+    from ..results.accuracy import ExpansionValidityWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ExpansionValidityWarning)
+        value = compute()
+    messages = list(dict.fromkeys(" ".join(str(w.message).split()) for w in caught if issubclass(w.category, ExpansionValidityWarning)))
+    if messages:
+        print("warning: " + "; ".join(messages), file=sys.stderr)
+    for other in (w for w in caught if not issubclass(w.category, ExpansionValidityWarning)):
+        warnings.warn_explicit(other.message, other.category, other.filename, other.lineno)
+    return value
 
 
 def _command_nnm(arguments: argparse.Namespace) -> str | tuple[str, int]:
@@ -159,16 +303,33 @@ def _command_nnm(arguments: argparse.Namespace) -> str | tuple[str, int]:
     system = UnilateralSystem.from_json_dict(data)
     if arguments.numeric:
         return _numeric_nnm(system, arguments)
-    if arguments.eps is not None or arguments.energy is not None:
-        raise ProblemError("--eps and --energy go with --numeric; the expansion's coefficients do not depend on epsilon")
+    if arguments.energy is not None:
+        raise ProblemError("--energy goes with --numeric (the expansion is parametrised by --a0, the modal amplitude)")
     if arguments.a0 is None:
         raise ProblemError("give --a0 (the modal amplitude of the mode), or --numeric with --energy")
+    epsilon = None
+    if arguments.eps is not None:
+        from ..problems.parsing import parse_float
+
+        epsilon = parse_float(arguments.eps, what="--eps")
     result = nnm(system, arguments.mode, arguments.a0, arguments.order, precision=arguments.precision)
+    value = None if epsilon is None else _warned(lambda: float(result.frequency(epsilon)))
     if arguments.format == "json":
-        return result.to_json()
+        if value is None:
+            return result.to_json()
+        data = json.loads(result.to_json())
+        data["evaluated"] = {"epsilon": epsilon, "omega": value}
+        return json.dumps(data, indent=2, allow_nan=False)
     if arguments.format == "latex":
-        return result.to_latex()
-    return result.summary()
+        text = result.to_latex()
+        if value is not None:
+            text = text.rstrip("\n") + f"\n\\[ \\omega({epsilon!r}) \\approx {value!r} \\]"
+        return text
+    if arguments.format == "pretty":
+        text = _pretty_nnm(result)
+        return text if value is None else text + f"\nω(ε = {epsilon!r}) = {value!r}"
+    text = result.summary()
+    return text if value is None else text + f"\nomega({epsilon!r}) = {value!r}"
 
 
 def _refuse_json_constant(name: str) -> None:
@@ -202,7 +363,7 @@ def _command_derive(arguments: argparse.Namespace) -> str | tuple[str, int]:
     if not arguments.name:
         raise ProblemError("name a derivation (lindstedt derive --list shows them)")
     result = common.run_script(arguments.name, order=arguments.order, output=arguments.output, directory=directory)
-    text = common.render(result, arguments.format)
+    text = common.render(result, "text" if arguments.format == "plain" else arguments.format)
     return text if result.agrees else (text, EXIT_FAILED)
 
 
@@ -229,10 +390,11 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     Examples
     --------
-    >>> main(["expand", "u**3", "--order", "1", "--a0", "1", "--omega0", "1"])
+    >>> main(["expand", "u**3", "--order", "1", "--a0", "1", "--omega0", "1", "--format", "plain", "--eps", "0.1"])
     u'' + u + eps*(u**3) = 0, u(0) = 1 [initial]
       omega_0 = 1
       omega_1 = 3/8
+    omega(0.1) = 1.0375
     0
     """
     status = 0
@@ -267,6 +429,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(output)
     except BrokenPipeError:  # e.g. `lindstedt expand ... | head`
         sys.stderr.close()
+    except UnicodeEncodeError:
+        return _fail("the output stream cannot encode Unicode; use --format plain (or set PYTHONIOENCODING=utf-8)", EXIT_BAD_INPUT)
     if status and output:
         print("error: the computation did not succeed (see its message above)", file=sys.stderr)
     return status

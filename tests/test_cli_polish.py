@@ -1,0 +1,164 @@
+"""The command line's polish: help on every option, --eps evaluation, pretty/plain output, nothing written unasked."""
+
+import argparse
+import json
+import os
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+from lindstedt.cli import build_parser, main
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+CHAIN = str(ROOT / "examples" / "chain2.json")
+
+
+def _subparsers(parser):
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            yield from action.choices.items()
+
+
+def test_every_option_of_every_subcommand_has_help():
+    parser = build_parser()
+    commands = dict(_subparsers(parser))
+    assert set(commands) == {"expand", "nnm", "derive", "demo"}
+    for name, sub in [("lindstedt", parser), *commands.items()]:
+        for action in sub._actions:
+            assert action.help and action.help.strip(), f"{name}: {action.option_strings or action.dest} has no help"
+
+
+def test_format_help_names_the_text_alias():
+    expand = dict(_subparsers(build_parser()))["expand"]
+    fmt = next(action for action in expand._actions if "--format" in action.option_strings)
+    assert fmt.default == "pretty" and {"pretty", "plain", "text", "latex", "json"} <= set(fmt.choices)
+    assert "alias" in fmt.help and "plain" in fmt.help
+
+
+def _last_value(text, prefix):
+    line = [line for line in text.splitlines() if line.startswith(prefix)][-1]
+    return float(line.rsplit("=", 1)[1])
+
+
+def test_expand_eps_prints_the_frequency_of_the_expansion(capsys):
+    assert main(["expand", "u**3", "--order", "2", "--a0", "1", "--omega0", "1", "--eps", "0.1"]) == 0
+    captured = capsys.readouterr()
+    assert captured.err == ""
+    assert _last_value(captured.out, "ω(ε = 0.1)") == pytest.approx(1 + 3 / 8 * 0.1 - 21 / 256 * 0.01, rel=1e-15)
+    assert main(["expand", "u**3", "--order", "2", "--a0", "1", "--omega0", "1", "--eps", "1/10", "--format", "plain"]) == 0
+    assert _last_value(capsys.readouterr().out, "omega(0.1)") == pytest.approx(1 + 3 / 8 * 0.1 - 21 / 256 * 0.01, rel=1e-15)
+    assert main(["expand", "u**3", "--order", "2", "--a0", "1", "--omega0", "1", "--eps", "0.1", "--format", "json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["evaluated"] == {"epsilon": 0.1, "omega": pytest.approx(1 + 3 / 8 * 0.1 - 21 / 256 * 0.01, rel=1e-15)}
+    assert data["omega"] == ["1", "3/8", "-21/256"]
+    assert main(["expand", "u**3", "--order", "1", "--a0", "1", "--omega0", "1", "--eps", "0.1", "--format", "latex"]) == 0
+    assert r"\omega(0.1) \approx 1.0375" in capsys.readouterr().out
+
+
+def test_expand_eps_warns_in_one_line_where_the_series_diverges(capsys):
+    assert main(["expand", "u**3", "--order", "2", "--a0", "1", "--omega0", "1", "--eps", "5"]) == 0
+    captured = capsys.readouterr()
+    lines = captured.err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("warning: ") and "not converging" in lines[0]
+    assert _last_value(captured.out, "ω(ε = 5.0)") == pytest.approx(1 + 3 / 8 * 5 - 21 / 256 * 25, rel=1e-15)
+
+
+def test_expand_eps_grazing_uses_the_sqrt_gauge(capsys):
+    # Max(0, u + 1) at a0 = 1 grazes: omega = 1 + eps/2 - eps^2/8 (in powers of sqrt(eps))
+    assert main(["expand", "Max(0, u + 1)", "--order", "2", "--a0", "1", "--omega0", "1", "--eps", "0.01"]) == 0
+    out = capsys.readouterr().out
+    assert "√ε" in out
+    assert _last_value(out, "ω(ε = 0.01)") == pytest.approx(1 + 0.01 / 2 - 0.01**2 / 8, rel=1e-14)
+
+
+@pytest.mark.parametrize(
+    "arguments, fragment",
+    [
+        (["expand", "u**3", "--order", "1", "--eps", "0.1"], "--a0 A and --omega0 W"),
+        (["expand", "u**3 + c*u**5", "--order", "1", "--a0", "1", "--omega0", "1", "--param", "c", "--eps", "0.1"], "NAME=VALUE"),
+        (["expand", "u**3", "--order", "1", "--a0", "1", "--omega0", "1", "--eps", "nan"], "--eps"),
+        (["expand", "u**3", "--order", "1", "--a0", "1", "--omega0", "1", "--eps", "abc"], "--eps"),
+        (["nnm", CHAIN, "--mode", "1", "--a0", "1", "--energy", "0.5"], "--numeric"),
+        (["expand", "u**3", "--format", "html"], "invalid choice"),
+    ],
+)
+def test_bad_eps_and_formats_are_one_error_line(arguments, fragment, capsys):
+    assert main(arguments) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("error: ") and fragment in err
+
+
+def test_pretty_is_the_default_and_plain_keeps_python_syntax(capsys):
+    assert main(["expand", "u**3", "--order", "2"]) == 0
+    pretty = capsys.readouterr().out
+    assert "ω₁" in pretty and "ε" in pretty and "a₀" in pretty and "─" in pretty  # a 2-D fraction bar
+    assert "omega_1" not in pretty
+    for alias in ("plain", "text"):
+        assert main(["expand", "u**3", "--order", "2", "--format", alias]) == 0
+        plain = capsys.readouterr().out
+        assert "  omega_1 = 3*a0**2/(8*omega0)" in plain.splitlines() and "ω" not in plain
+    assert main(["expand", "u**3", "--order", "1", "--u0", "3/5", "--v0", "4/5", "--omega0", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "φ₀ = -atan(4/3)" in out and "A₀ = 1" in out
+    assert main(["expand", "u**2", "--order", "1", "--a0", "1", "--omega0", "1", "--waveforms"]) == 0
+    assert "v₁(s) =" in capsys.readouterr().out
+
+
+def test_nnm_eps_evaluates_the_expansion(capsys):
+    import lindstedt
+
+    expansion = lindstedt.nnm(lindstedt.UnilateralSystem.from_json_dict(json.loads(pathlib.Path(CHAIN).read_text())), mode=1, a0=1)
+    expected = float(expansion.frequency(0.05))
+    assert main(["nnm", CHAIN, "--mode", "1", "--a0", "1", "--eps", "0.05"]) == 0
+    out = capsys.readouterr().out
+    assert "λ = " in out and "ω₂ = " in out
+    assert _last_value(out, "ω(ε = 0.05)") == pytest.approx(expected, rel=1e-15)
+    assert main(["nnm", CHAIN, "--mode", "1", "--a0", "1", "--eps", "0.05", "--format", "json"]) == 0
+    assert json.loads(capsys.readouterr().out)["evaluated"]["omega"] == pytest.approx(expected, rel=1e-15)
+    assert main(["nnm", CHAIN, "--mode", "1", "--a0", "1", "--format", "plain"]) == 0
+    assert "  omega_0 = 1.0" in capsys.readouterr().out.splitlines()
+
+
+def test_help_documents_eps_and_formats(capsys):
+    assert main(["expand", "--help"]) == 0
+    out = capsys.readouterr().out
+    assert "--eps" in out and "pretty" in out and "alias" in out
+
+
+def test_nothing_is_written_unasked(tmp_path, monkeypatch):
+    from lindstedt.cli import demo
+
+    calls = []
+    monkeypatch.setattr(demo, "run_demo", lambda order, figure_path: calls.append(figure_path) or "tour")
+    monkeypatch.chdir(tmp_path)
+    assert main(["demo"]) == 0 and calls == [None]
+    assert main(["derive", "--list"]) == 0
+    assert main(["expand", "u**3", "--order", "1", "--eps", "0.1", "--a0", "1", "--omega0", "1"]) == 0
+    assert list(tmp_path.iterdir()) == []
+    assert main(["demo", "--figure", "x.svg"]) == 0 and calls[-1] == "x.svg"
+
+
+def test_default_outputs_are_git_ignored():
+    ignored = (ROOT / ".gitignore").read_text(encoding="utf-8").split()
+    assert "out/" in ignored and "lindstedt-demo.svg" in ignored
+
+
+def test_packaging_metadata_and_markers():
+    tomllib = pytest.importorskip("tomllib")  # Python 3.11+
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    assert (ROOT / "lindstedt" / "py.typed").is_file()
+    assert "py.typed" in project["tool"]["setuptools"]["package-data"]["lindstedt"]
+    assert "Typing :: Typed" in project["project"]["classifiers"] and project["project"]["keywords"]
+    citation = (ROOT / "CITATION.cff").read_text(encoding="utf-8")
+    assert "cff-version:" in citation and "title:" in citation and "Junca" in citation
+
+
+def test_unencodable_terminal_names_the_plain_format():
+    result = subprocess.run(
+        [sys.executable, "-m", "lindstedt", "expand", "u**3", "--order", "1"],
+        capture_output=True, text=True, timeout=120, check=False, env={**os.environ, "PYTHONIOENCODING": "ascii"},
+    )
+    assert result.returncode == 2 and result.stderr.startswith("error: ") and "--format plain" in result.stderr
