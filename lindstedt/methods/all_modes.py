@@ -80,6 +80,34 @@ class AllModesFirstOrder(JsonExport):
         """λ_k^ε = λ_k + ε λ_k¹ for every mode."""
         return np.array(self.lambdas) + epsilon * np.array([value for value, _ in self.corrections])
 
+    def _display_rows(self) -> list[tuple[str, str, str, str, str]]:
+        from ..export.display import format_number
+
+        return [(str(k + 1), format_number(lam), format_number(amplitude), f"{format_number(value)} ± {format_number(error, 2)}", method)
+                for k, (lam, amplitude, (value, error), method) in enumerate(zip(self.lambdas, self.amplitudes, self.corrections, self.methods))]
+
+    def __repr__(self) -> str:
+        """One labelled line per mode: λ_k, a_k, the correction λ_k¹ ± its error estimate and how it was obtained.
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> result = lindstedt.all_modes_first_order(lindstedt.UnilateralSystem.one_dof(1), [1.0])
+        >>> print(repr(result).splitlines()[1])
+          mode 1: lambda=1, a=1, correction=0.25 ± 0, closed form (zero gaps)
+        """
+        from ..export.display import shorten
+
+        head = f"AllModesFirstOrder(success={self.success}, polarised_mode={self.polarised_mode}, message={shorten(self.message, 120)!r},"
+        lines = [f"  mode {k}: lambda={lam}, a={a}, correction={c}, {m}" for k, lam, a, c, m in self._display_rows()]
+        return "\n".join([head, *lines, f"  averaging_time={self.averaging_time:g}, samples={self.samples})"])
+
+    def _repr_html_(self) -> str:
+        """Jupyter's rendering: one row per mode."""
+        from ..export.display import html_grid
+
+        return html_grid("AllModesFirstOrder", ["mode", "λ_k", "a_k", "λ_k¹ ± error", "method"], self._display_rows(), note=self.message)
+
 
 def _hann_average(times: np.ndarray, values: np.ndarray) -> float:
     window = np.sin(np.pi * times / times[-1]) ** 2

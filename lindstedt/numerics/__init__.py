@@ -61,7 +61,7 @@ from .flow import ExactFlow, FlowMapResult, FlowResult, SwitchEvent
 from .smooth import smooth_flow
 from .continuation import continue_nnm, nnm_sweep
 from .examples import seed_example_system
-from .results import ContinuationProgress, NNMBranch, NNMResult
+from .results import ContinuationProgress, NNMBranch, NNMResult, to_dataframe
 from .sensitivity import flow_epsilon_derivative
 from .shooting import NNMShooting, nnm_energy, nnm_point
 
@@ -81,4 +81,5 @@ __all__ = [
     "nnm_sweep",
     "nnm_energy",
     "seed_example_system",
+    "to_dataframe",
 ]

@@ -29,7 +29,7 @@ import numpy as np
 from ..export.display import format_number, format_vector, html_grid, html_table, labelled_repr
 from ..export.json import JsonExport, finite_float, to_jsonable
 
-__all__ = ["ContinuationProgress", "NNMBranch", "NNMResult"]
+__all__ = ["ContinuationProgress", "NNMBranch", "NNMResult", "to_dataframe"]
 
 
 @dataclass(frozen=True)
@@ -389,6 +389,23 @@ class NNMBranch(JsonExport):
             ("wall_time", f"{self.wall_time:.3g} s"),
         ]
 
+    def to_dataframe(self) -> Any:
+        """The branch as a pandas DataFrame: one row per point, the continuation parameter's column first
+        (the columns of :func:`to_dataframe`, plus ``jump_after``: the point is followed by a jump).
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> branch = lindstedt.continue_nnm(lindstedt.UnilateralSystem.one_dof(1), 1, start=0.0, stop=0.5, modal_amplitude=1.0)
+        >>> table = branch.to_dataframe()
+        >>> list(table.columns[:3]), len(table) == len(branch.points)
+        (['epsilon', 'success', 'frequency'], True)
+        """
+        table = to_dataframe(self.points)
+        table = table[[self.parameter, *(column for column in table.columns if column != self.parameter)]]
+        table["jump_after"] = [index in set(self.jumps) for index in range(len(self.points))]
+        return table
+
     def __repr__(self) -> str:
         """A summary (ranges, events, cost), never the points themselves (``.points``, ``.frequencies``…).
 
@@ -443,3 +460,44 @@ def _branch_events(points: Sequence[NNMResult], values: Sequence[float]) -> tupl
     contact = tuple(k for k, (a, b) in enumerate(pairs)
                     if a.contact != b.contact or a.contact_springs != b.contact_springs)
     return folds, stability, contact
+
+
+def to_dataframe(results: Sequence[NNMResult]) -> Any:
+    """NNM points (a sweep's list, a branch's points) as a pandas DataFrame, one row per point.
+
+    Columns: ``success, frequency, period, epsilon, energy, modal_amplitude, stable, max_abs_multiplier,
+    residual, n_switches, mode_share, newton_iterations, flow_evaluations, message`` (pandas is optional:
+    ``pip install pandas``).
+
+    Examples
+    --------
+    >>> import lindstedt
+    >>> from lindstedt.numerics import to_dataframe
+    >>> points = lindstedt.nnm_sweep(lindstedt.UnilateralSystem.one_dof(1), 1, [0.1, 0.2], modal_amplitude=1.0)
+    >>> to_dataframe(points)[["epsilon", "frequency"]].round(6).values.tolist()
+    [[0.1, 1.023823], [0.2, 1.045549]]
+    """
+    try:
+        import pandas
+    except ImportError as error:
+        from .._errors import LindstedtError
+
+        raise LindstedtError("tables need pandas: pip install pandas (or pip install 'lindstedt[pandas]')") from error
+
+    def largest(result: NNMResult) -> float:
+        multipliers = np.asarray(result.floquet_multipliers) if result.floquet_multipliers is not None else np.array([])
+        return float(np.max(np.abs(multipliers))) if multipliers.size else float("nan")
+
+    rows = [
+        {
+            "success": result.success, "frequency": result.frequency, "period": result.period, "epsilon": result.epsilon,
+            "energy": result.energy, "modal_amplitude": result.modal_amplitude, "stable": result.stable,
+            "max_abs_multiplier": largest(result), "residual": result.residual, "n_switches": result.n_switches,
+            "mode_share": result.mode_share, "newton_iterations": result.newton_iterations,
+            "flow_evaluations": result.flow_evaluations, "message": result.message,
+        }
+        for result in results
+    ]
+    return pandas.DataFrame(rows, columns=["success", "frequency", "period", "epsilon", "energy", "modal_amplitude", "stable",
+                                           "max_abs_multiplier", "residual", "n_switches", "mode_share", "newton_iterations",
+                                           "flow_evaluations", "message"])
