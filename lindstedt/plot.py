@@ -13,7 +13,9 @@ None) and returns the Axes; the data drawn are those of the package's results an
 * :func:`convergence` — max error against ε on log-log axes with the fitted slope
   (:class:`lindstedt.validate.ConvergenceFit`);
 * :func:`branch` — an NNM branch (:class:`lindstedt.NNMBranch`): frequency against the continuation parameter,
-  stable points solid, unstable dashed, jumps across internal-resonance tongues marked.
+  stable points solid, unstable dashed, jumps across internal-resonance tongues marked;
+* :func:`nnm_orbit` — one NNM (:class:`lindstedt.NNMResult`) over a period of the exact flow: the orbit in
+  configuration space (X_i, X_j) and the line spectrum of X_i (seed figs. 3–8).
 
 Examples
 --------
@@ -34,7 +36,7 @@ import numpy as np
 
 from ._errors import LindstedtError
 
-__all__ = ["backbone", "branch", "convergence", "spectrum", "waveform"]
+__all__ = ["backbone", "branch", "convergence", "nnm_orbit", "spectrum", "waveform"]
 
 
 def _axes(ax: Any) -> Any:
@@ -232,3 +234,59 @@ def branch(nnm_branch: Any, *, ax: Any = None) -> Any:
     ax.set_title(f"{'complete' if nnm_branch.success else 'stopped'}: {len(values)} points")
     ax.legend()
     return ax
+
+
+def nnm_orbit(point: Any, *, dofs: tuple[int, int] = (0, 1), samples: int = 512, axes: Any = None) -> tuple[Any, Any]:
+    """One NNM over one period of the exact flow: (X_i, X_j) in configuration space, and the spectrum of X_i.
+
+    Parameters
+    ----------
+    point : NNMResult
+        A converged NNM (:func:`lindstedt.nnm_point`, a branch's point).
+    dofs : (int, int)
+        0-based degrees of freedom on the two axes of the configuration plot.
+    samples : int
+        Samples of the period (the flow is evaluated in closed form at each).
+    axes : (Axes, Axes), optional
+        Where to draw; a new figure with two panels by default.
+
+    Returns
+    -------
+    (Axes, Axes)
+        The configuration-space panel and the spectrum panel.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import lindstedt, lindstedt.plot
+    >>> point = lindstedt.nnm_point(lindstedt.UnilateralSystem.chain(2, [(0, 0.1)]), 0.2, 1, modal_amplitude=1.0)
+    >>> orbit, lines = lindstedt.plot.nnm_orbit(point)
+    >>> orbit.get_xlabel(), lines.get_yscale()
+    ('$X_{1}$', 'log')
+    """
+    import lindstedt
+
+    if not point.success:
+        raise LindstedtError(f"the NNM did not converge ({point.message}); plot a converged point")
+    if axes is None:
+        import matplotlib.pyplot as plt
+
+        _axes(None)  # the error naming the extra when matplotlib is missing
+        _, axes = plt.subplots(1, 2, figsize=(10, 4))
+    orbit, lines = axes
+    flow = lindstedt.ExactFlow(point.system, point.epsilon).solve(point.release_position, point.release_velocity, point.period)
+    if not flow.success:
+        raise LindstedtError(f"the exact flow failed: {flow.message}")
+    times = np.linspace(0.0, point.period, samples, endpoint=False)
+    positions, _ = flow.state(times)
+    first, second = dofs
+    orbit.plot(positions[:, first], positions[:, second], label=f"mode {point.mode}, ε = {point.epsilon:g}")
+    orbit.set_xlabel(f"$X_{{{first + 1}}}$")
+    orbit.set_ylabel(f"$X_{{{second + 1}}}$")
+    orbit.set_title(f"NNM in configuration space, ω = {point.frequency:.6g}")
+    orbit.legend()
+    line_spectrum = lindstedt.spectrum(positions[:, first], point.period, periods=1)
+    spectrum([line_spectrum], labels=[f"$X_{{{first + 1}}}$"], ax=lines)
+    lines.set_title("line spectrum over one period")
+    return orbit, lines

@@ -96,3 +96,22 @@ def test_without_matplotlib_the_error_names_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "matplotlib.pyplot", None)
     with pytest.raises(lindstedt.LindstedtError, match=r"pip install 'lindstedt\[plot\]'"):
         lindstedt.plot.waveform(lindstedt.expand("u**3", order=1, a0=1, omega0=1), 0.1, [0.0, 1.0])
+
+
+def test_nnm_orbit_of_the_seed_system_is_the_linear_mode_line_at_the_nonlinear_frequency():
+    # seed system (5 dof): only u_1 is nonlinear, so the mode-1 NNM keeps every other modal coordinate at zero —
+    # in configuration space X(t) = φ_1 q(t) is a segment along the first mode shape — and, with F = (X_1)_+ M φ_1,
+    # q'' + λ1² q + ε (φ_11 q)_+ = 0 is bilinear: ω = 2 λ1 k / (λ1 + k), k² = λ1² + ε φ_11 (half a period per side)
+    system = lindstedt.seed_example_system(5)
+    epsilon = 0.2581
+    point = lindstedt.nnm_point(system, epsilon, 1, modal_amplitude=1.0)
+    orbit, lines = lindstedt.plot.nnm_orbit(point, dofs=(0, 2))
+    x, y = orbit.get_lines()[0].get_data()
+    shape = np.asarray(system.modes().shapes, dtype=float)[:, 0]
+    assert np.allclose(y * shape[0], x * shape[2], atol=1e-12)  # collinear with φ_1
+    assert (x[0], y[0]) == pytest.approx((point.release_position[0], point.release_position[2]), abs=1e-13)
+    lam = float(system.modes().frequencies[0])
+    stiff = math.sqrt(lam**2 + epsilon * shape[0])
+    assert point.frequency == pytest.approx(2 * lam * stiff / (lam + stiff), rel=1e-12)
+    fundamental = min(lines.collections[0].get_segments(), key=lambda segment: segment[0, 0] if segment[0, 0] > 1e-9 else np.inf)
+    assert fundamental[0, 0] == pytest.approx(point.frequency, rel=1e-12)
