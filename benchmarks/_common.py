@@ -4,13 +4,16 @@
 * :func:`ensure_peer_venv` — the cached virtual environment ``benchmarks/.peer-venv`` holding a peer
   package for benchmarking only (never a project dependency).
 * :func:`run_worker` — run a worker script in a fresh interpreter, with a timeout, and read the one JSON
-  result line it prints.
+  result line it prints; :func:`emit` is the worker's side of it.
+* :func:`per_call` — the per-call time of a fast function (a timed loop, minimum over repeats).
+* :func:`format_seconds`, :func:`format_error` — the tables' cells.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
 import json
+import math
 import os
 import platform
 import subprocess
@@ -19,7 +22,7 @@ import time
 from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 BENCH_DIR = Path(__file__).resolve().parent
 REPO_DIR = BENCH_DIR.parent
@@ -165,3 +168,47 @@ def write_json(name: str, data: Any) -> Path:
     path = RESULTS_DIR / name
     path.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n")
     return path
+
+
+def emit(result: dict[str, Any]) -> None:
+    """A worker's result: one ``RESULT_MARKER`` JSON line on stdout (read by :func:`run_worker`)."""
+    print(RESULT_MARKER + json.dumps(result), flush=True)
+
+
+def per_call(function: Callable[[], Any], repeats: int, min_seconds: float = 0.02) -> tuple[float, Any]:
+    """Per-call time: minimum over ``repeats`` of the mean of a loop lasting ≥ ``min_seconds`` (one untimed
+    call first), and the last result."""
+    result = function()
+    start = time.perf_counter()
+    function()
+    single = time.perf_counter() - start
+    loops = max(1, int(min_seconds / max(single, 1e-7)))
+    best = math.inf
+    for _ in range(repeats):
+        start = time.perf_counter()
+        for _ in range(loops):
+            result = function()
+        best = min(best, (time.perf_counter() - start) / loops)
+    return best, result
+
+
+def _missing(x: Any) -> bool:
+    return x is None or (isinstance(x, float) and math.isnan(x))
+
+
+def format_seconds(seconds: float | None) -> str:
+    """3 significant digits in µs, ms or s; "—" when there is no value."""
+    if _missing(seconds):
+        return "—"
+    if seconds < 1e-3:
+        return f"{seconds * 1e6:.3g} µs"
+    if seconds < 1:
+        return f"{seconds * 1e3:.3g} ms"
+    return f"{seconds:.3g} s"
+
+
+def format_error(x: float | None) -> str:
+    """An error as 1.2e-05 ("0" when exact, "—" when there is no value)."""
+    if _missing(x):
+        return "—"
+    return "0" if x == 0 else f"{x:.1e}"

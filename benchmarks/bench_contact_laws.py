@@ -30,7 +30,6 @@ import statistics
 import subprocess
 import sys
 import time
-from collections.abc import Callable
 from fractions import Fraction
 from itertools import pairwise
 from pathlib import Path
@@ -41,11 +40,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import (
     BENCH_DIR,
     REPO_DIR,
-    RESULT_MARKER,
     load_average,
     run_worker,
     write_json,
 )
+from _common import emit as _emit, format_error as _e, format_seconds as _t, per_call as _warm  # noqa: E402
 
 TITLE = "Contact laws (issue 12): time to ω4 per class, accuracy, and harmonic balance against the series"
 SELF = Path(__file__).resolve()
@@ -190,26 +189,6 @@ def hb_hybr(epsilon: float, harmonics: int, samples: int, kappa: float) -> tuple
 # =================================================================================================================
 # workers (fresh interpreters)
 # =================================================================================================================
-def _emit(result: dict[str, Any]) -> None:
-    print(RESULT_MARKER + json.dumps(result), flush=True)
-
-
-def _warm(function: Callable[[], Any], repeats: int, min_seconds: float = 0.02) -> tuple[float, Any]:
-    """Per-call time: minimum over ``repeats`` of the mean of a loop lasting ≥ ``min_seconds`` (one untimed call first)."""
-    result = function()
-    start = time.perf_counter()
-    function()
-    single = time.perf_counter() - start
-    loops = max(1, int(min_seconds / max(single, 1e-7)))
-    best = math.inf
-    for _ in range(repeats):
-        start = time.perf_counter()
-        for _ in range(loops):
-            result = function()
-        best = min(best, (time.perf_counter() - start) / loops)
-    return best, result
-
-
 def _worker_expand(spec: dict[str, Any]) -> None:
     """One expansion to ``order`` of ``f`` in a fresh process: time (imports excluded), ω_k to 50 digits."""
     sys.path.insert(0, str(REPO_DIR))  # measure this tree, not whatever the venv has installed
@@ -394,24 +373,6 @@ def _series_error(omega: list[str], epsilon: float, reference: str) -> float:
 # =================================================================================================================
 # formatting
 # =================================================================================================================
-def _t(seconds: float | None) -> str:
-    if seconds is None or (isinstance(seconds, float) and math.isnan(seconds)):
-        return "—"
-    if seconds < 1e-3:
-        return f"{seconds * 1e6:.3g} µs"
-    if seconds < 1:
-        return f"{seconds * 1e3:.3g} ms"
-    return f"{seconds:.3g} s"
-
-
-def _e(x: float | None) -> str:
-    if x is None or (isinstance(x, float) and math.isnan(x)):
-        return "—"
-    if x == 0:
-        return "0"
-    return f"{x:.1e}"
-
-
 def _eps_tag(epsilon: float) -> str:
     return repr(epsilon).replace(".", "p")
 

@@ -40,6 +40,7 @@ from typing import Any, Callable
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _common import BENCH_DIR, RESULT_MARKER, load_average, run_worker, write_json  # noqa: E402
+from _common import format_seconds as _t, per_call as _warm  # noqa: E402
 
 TITLE = "Method pairs: run time against error (LP expansion, closed forms, quadrature, shooting, DOP853)"
 SELF = Path(__file__).resolve()
@@ -114,22 +115,6 @@ def _cold(function: Callable[[], Any], repeats: int) -> tuple[float, Any]:
         start = time.perf_counter()
         result = function()
         best = min(best, time.perf_counter() - start)
-    return best, result
-
-
-def _warm(function: Callable[[], Any], repeats: int, min_seconds: float = 0.02) -> tuple[float, Any]:
-    """Per-call time, minimum over ``repeats`` of a loop lasting ≥ ``min_seconds`` (after one untimed call)."""
-    result = function()
-    start = time.perf_counter()
-    function()
-    single = time.perf_counter() - start
-    loops = max(1, int(min_seconds / max(single, 1e-7)))
-    best = math.inf
-    for _ in range(repeats):
-        start = time.perf_counter()
-        for _ in range(loops):
-            result = function()
-        best = min(best, (time.perf_counter() - start) / loops)
     return best, result
 
 
@@ -556,14 +541,6 @@ def _g(value: float, digits: int = 2) -> str:
     if value == 0:
         return "0"
     return f"{value:.{digits}g}" if 1e-3 <= abs(value) < 1e4 else f"{value:.{digits - 1}e}"
-
-
-def _t(seconds: float) -> str:
-    if seconds < 1e-3:
-        return f"{seconds * 1e6:.3g} µs"
-    if seconds < 1:
-        return f"{seconds * 1e3:.3g} ms"
-    return f"{seconds:.3g} s"
 
 
 def _eps_tag(epsilon: float) -> str:

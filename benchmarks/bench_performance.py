@@ -21,46 +21,31 @@ import subprocess
 import sys
 import time
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import REPO_DIR, RESULT_MARKER, load_average, run_worker, write_json  # noqa: E402
+from _common import REPO_DIR, emit as _emit, format_error as _e, format_seconds as _t, load_average, per_call, run_worker, write_json  # noqa: E402
 
 TITLE = "Performance (issue 13): every target as a ratio to its floor, one run"
 SELF = Path(__file__).resolve()
 RAW_NAME = "performance.json"
-CHAIN_SPRINGS = "[(0, 0.1), (size // 2, -0.05), (size - 1, 0.0)]"  # the chain of benchmarks/bench_nnm_scaling.py
+CHAIN_SPRINGS = "[(0, 0.1), (N // 2, -0.05), (N - 1, 0.0)]"  # the chain of benchmarks/bench_nnm_scaling.py
+
+
+def chain_springs(size: int) -> list[tuple[int, float]]:
+    """The unilateral springs of the benchmark chain (:data:`CHAIN_SPRINGS`)."""
+    return [(0, 0.1), (size // 2, -0.05), (size - 1, 0.0)]
 
 
 # =================================================================================================================
 # workers (fresh interpreters)
 # =================================================================================================================
-def _emit(result: dict[str, Any]) -> None:
-    print(RESULT_MARKER + json.dumps(result), flush=True)
-
-
 def _import() -> Any:
     sys.path.insert(0, str(REPO_DIR))  # measure this tree, not whatever the venv has installed
     import lindstedt
 
     return lindstedt
-
-
-def _per_call(function: Callable[[], Any], repeats: int = 5, min_seconds: float = 0.05) -> float:
-    """Per-call time: minimum over ``repeats`` of the mean of a loop lasting ≥ ``min_seconds`` (one untimed call first)."""
-    function()
-    start = time.perf_counter()
-    function()
-    single = time.perf_counter() - start
-    loops = max(1, int(min_seconds / max(single, 1e-7)))
-    best = math.inf
-    for _ in range(repeats):
-        start = time.perf_counter()
-        for _ in range(loops):
-            function()
-        best = min(best, (time.perf_counter() - start) / loops)
-    return best
 
 
 def _worker_duffing(spec: dict[str, Any]) -> None:
@@ -132,7 +117,7 @@ def _worker_numeric_kappa(spec: dict[str, Any]) -> None:
                               "double": repr(value)})
     kappa_symbol = next(iter(set().union(*(sympy.sympify(w).free_symbols for w in symbolic))))
     closed = sympy.lambdify(kappa_symbol, list(symbolic[1:]), "math")
-    floor = min(_per_call(lambda k=float(sympy.Rational(kappa)): closed(k), repeats=3) for kappa in spec["kappas"])
+    floor = min(per_call(lambda k=float(sympy.Rational(kappa)): closed(k), 3, 0.05)[0] for kappa in spec["kappas"])
     _emit({"rows": rows, "floor_seconds": floor, "compiled": compiled_rows})
 
 
@@ -144,9 +129,9 @@ def _worker_evaluation(spec: dict[str, Any]) -> None:
     start = time.perf_counter()
     expansion.frequency(0.01)
     first = time.perf_counter() - start
-    warm = _per_call(lambda: expansion.frequency(0.01))
+    warm = per_call(lambda: expansion.frequency(0.01), 5, 0.05)[0]
     compiled = expansion.lambdify("frequency")
-    lambdified = _per_call(lambda: compiled(0.01))
+    lambdified = per_call(lambda: compiled(0.01), 5, 0.05)[0]
     _emit({"first": first, "warm": warm, "lambdified": lambdified, "value": float(expansion.frequency(0.01))})
 
 
@@ -170,7 +155,7 @@ def _worker_new_kappa(spec: dict[str, Any]) -> None:
     arguments = {str(s): s for s in symbols}
     order_of = [next(name for name in arguments if name.startswith(prefix)) for prefix in ("eps", "kappa")]
     call = (lambda k: compiled(*(0.05 if str(s) == order_of[0] else k for s in symbols)))
-    lambdified = min(_per_call(lambda k=float(sympy.Rational(v)): call(k), repeats=3) for v in spec["kappas"])
+    lambdified = min(per_call(lambda k=float(sympy.Rational(v)): call(k), 3, 0.05)[0] for v in spec["kappas"])
     reference = [call(float(sympy.Rational(v))) for v in spec["kappas"]]
     _emit({"first": first, "times": times, "values": values, "lambdified": lambdified, "reference": reference})
 
@@ -178,7 +163,7 @@ def _worker_new_kappa(spec: dict[str, Any]) -> None:
 def _worker_nnm(spec: dict[str, Any]) -> None:
     lindstedt = _import()
     size, mode = spec["size"], spec["mode"]
-    springs = eval(CHAIN_SPRINGS, {"size": size})  # noqa: S307 - a constant of this file
+    springs = chain_springs(size)
     system = lindstedt.UnilateralSystem.chain(size, unilateral=springs)
     start = time.perf_counter()
     result = lindstedt.nnm(system, mode=mode, a0=1.0, order=2)
@@ -189,7 +174,7 @@ def _worker_nnm(spec: dict[str, Any]) -> None:
 def _worker_continuation(spec: dict[str, Any]) -> None:
     lindstedt = _import()
     size = spec["size"]
-    springs = eval(CHAIN_SPRINGS, {"size": size})  # noqa: S307 - a constant of this file
+    springs = chain_springs(size)
     system = lindstedt.UnilateralSystem.chain(size, unilateral=springs)
     start = time.perf_counter()
     branch = lindstedt.continue_nnm(system, spec["mode"], start=spec["start"], stop=spec["stop"],
@@ -240,20 +225,6 @@ def _whole_process(code: str, runs: int) -> list[float]:
 # =================================================================================================================
 # formatting
 # =================================================================================================================
-def _t(seconds: float | None) -> str:
-    if seconds is None or not math.isfinite(seconds):
-        return "—"
-    if seconds < 1e-3:
-        return f"{seconds * 1e6:.3g} µs"
-    if seconds < 1:
-        return f"{seconds * 1e3:.3g} ms"
-    return f"{seconds:.3g} s"
-
-
-def _e(x: float | None) -> str:
-    return "—" if x is None else ("0" if x == 0 else f"{x:.1e}")
-
-
 def _power_fit(sizes: list[float], times: list[float]) -> float | None:
     """Least-squares slope of log t against log N (time ∝ N^p)."""
     points = [(math.log(n), math.log(t)) for n, t in zip(sizes, times) if t and t > 0]

@@ -30,7 +30,8 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import RESULT_MARKER, load_average, run_worker, write_json  # noqa: E402
+from _common import load_average, run_worker, write_json  # noqa: E402
+from _common import emit as _emit, format_error as _e  # noqa: E402
 
 TITLE = "Unilateral spring u'' + u + ε (u − b)_+: numeric engine, closed forms, generated code, series methods"
 SELF = Path(__file__).resolve()
@@ -196,10 +197,6 @@ def _mp_text(value: Any) -> str:
 
     with mpmath.workdps(80):  # prints the stored binary value (any precision up to ~265 bits) faithfully
         return str(value)
-
-
-def _emit(result: dict[str, Any]) -> None:
-    print(RESULT_MARKER + json.dumps(result), flush=True)
 
 
 def _numeric_kwargs(kappa_text: str, order: int) -> dict[str, Any]:
@@ -430,14 +427,6 @@ def _s(seconds: float) -> str:
     if seconds >= 1e-3:
         return f"{seconds * 1e3:.3g} ms"
     return f"{seconds * 1e6:.3g} µs"
-
-
-def _e(x: float) -> str:
-    if x is None or (isinstance(x, float) and math.isnan(x)):
-        return "—"
-    if x == 0:
-        return "0"
-    return f"{x:.1e}"
 
 
 def _digits(relative: float) -> str:
