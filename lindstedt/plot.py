@@ -39,13 +39,17 @@ from ._errors import LindstedtError
 __all__ = ["backbone", "branch", "convergence", "nnm_orbit", "spectrum", "waveform"]
 
 
-def _axes(ax: Any) -> Any:
+def _pyplot() -> Any:
     try:
         import matplotlib.pyplot as plt
     except ImportError as error:
         raise LindstedtError("plotting needs matplotlib: pip install 'lindstedt[plot]'") from error
+    return plt
+
+
+def _axes(ax: Any) -> Any:
     if ax is None:
-        _, ax = plt.subplots()
+        _, ax = _pyplot().subplots()
     return ax
 
 
@@ -270,10 +274,7 @@ def nnm_orbit(point: Any, *, dofs: tuple[int, int] = (0, 1), samples: int = 512,
     if not point.success:
         raise LindstedtError(f"the NNM did not converge ({point.message}); plot a converged point")
     if axes is None:
-        import matplotlib.pyplot as plt
-
-        _axes(None)  # the error naming the extra when matplotlib is missing
-        _, axes = plt.subplots(1, 2, figsize=(10, 4))
+        _, axes = _pyplot().subplots(1, 2, figsize=(10, 4))
     orbit, lines = axes
     flow = lindstedt.ExactFlow(point.system, point.epsilon).solve(point.release_position, point.release_velocity, point.period)
     if not flow.success:

@@ -130,6 +130,13 @@ class NNMResult(JsonExport):
         """``u_j(0)``, the release modal coordinate of the NNM's own mode."""
         return float(self.modal_coordinates[self.mode - 1])
 
+    @property
+    def max_abs_multiplier(self) -> float | None:
+        """max |μ| over the Floquet multipliers (None when they were not computed)."""
+        if self.floquet_multipliers is None or not np.size(self.floquet_multipliers):
+            return None
+        return float(np.max(np.abs(self.floquet_multipliers)))
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready data (schema ``lindstedt.nnm-numeric/1``); NaN and infinities become ``None``.
 
@@ -176,7 +183,7 @@ class NNMResult(JsonExport):
         """One line: mode, ε, ω, T, energy, stability, cost."""
         if not self.success:
             return f"mode {self.mode}, ε = {self.epsilon:g}: FAILED — {self.message}"
-        largest = float(np.max(np.abs(self.floquet_multipliers))) if self.floquet_multipliers is not None else float("nan")
+        largest = float("nan") if self.max_abs_multiplier is None else self.max_abs_multiplier
         return (
             f"mode {self.mode}, ε = {self.epsilon:g}: ω = {self.frequency:.12g} (λ_j = {self.linear_frequency:.12g}), "
             f"T = {self.period:.12g}, E = {self.energy:.6g}, max|μ| = {largest:.6g} "
@@ -187,9 +194,7 @@ class NNMResult(JsonExport):
     # -- display -----------------------------------------------------------------------------
     def _display_rows(self, quoted: bool = True) -> list[tuple[str, str]]:
         """(label, text) of the fields people read first: outcome, frequencies, release, stability, cost."""
-        largest = (
-            format_number(float(np.max(np.abs(self.floquet_multipliers))), 6) if self.floquet_multipliers is not None else "None"
-        )
+        largest = "None" if self.max_abs_multiplier is None else format_number(self.max_abs_multiplier, 6)
         return [
             ("success", str(bool(self.success))),
             ("message", repr(self.message) if quoted else self.message),
@@ -403,7 +408,8 @@ class NNMBranch(JsonExport):
         """
         table = to_dataframe(self.points)
         table = table[[self.parameter, *(column for column in table.columns if column != self.parameter)]]
-        table["jump_after"] = [index in set(self.jumps) for index in range(len(self.points))]
+        jumps = set(self.jumps)
+        table["jump_after"] = [index in jumps for index in range(len(self.points))]
         return table
 
     def __repr__(self) -> str:
@@ -484,15 +490,11 @@ def to_dataframe(results: Sequence[NNMResult]) -> Any:
 
         raise LindstedtError("tables need pandas: pip install pandas (or pip install 'lindstedt[pandas]')") from error
 
-    def largest(result: NNMResult) -> float:
-        multipliers = np.asarray(result.floquet_multipliers) if result.floquet_multipliers is not None else np.array([])
-        return float(np.max(np.abs(multipliers))) if multipliers.size else float("nan")
-
     rows = [
         {
             "success": result.success, "frequency": result.frequency, "period": result.period, "epsilon": result.epsilon,
             "energy": result.energy, "modal_amplitude": result.modal_amplitude, "stable": result.stable,
-            "max_abs_multiplier": largest(result), "residual": result.residual, "n_switches": result.n_switches,
+            "max_abs_multiplier": float("nan") if result.max_abs_multiplier is None else result.max_abs_multiplier, "residual": result.residual, "n_switches": result.n_switches,
             "mode_share": result.mode_share, "newton_iterations": result.newton_iterations,
             "flow_evaluations": result.flow_evaluations, "message": result.message,
         }
