@@ -146,7 +146,7 @@ def test_default_outputs_are_git_ignored():
 
 
 def test_packaging_metadata_and_markers():
-    tomllib = pytest.importorskip("tomllib")  # Python 3.11+
+    tomllib = pytest.importorskip("tomllib", reason="tomllib is in the standard library from Python 3.11 on")
 
     project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
     assert (ROOT / "lindstedt" / "py.typed").is_file()

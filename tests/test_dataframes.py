@@ -9,7 +9,7 @@ import pytest
 import lindstedt
 from lindstedt.numerics import to_dataframe
 
-pandas = pytest.importorskip("pandas")
+pandas = pytest.importorskip("pandas", reason="tables are optional: pip install 'lindstedt[pandas]'")
 
 
 def bilinear(epsilon):

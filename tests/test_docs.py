@@ -18,7 +18,7 @@ def test_the_pages_exist():
 
 @pytest.mark.parametrize("page", [p for p in PAGES if ">>>" in p.read_text(encoding="utf-8")], ids=lambda p: p.name)
 def test_page_examples_pass(page):
-    pytest.importorskip("matplotlib")
+    pytest.importorskip("matplotlib", reason="the tutorial draws a figure: pip install 'lindstedt[plot]'")
     parser = doctest.DocTestParser()
     runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
     test = parser.get_doctest(page.read_text(encoding="utf-8"), {}, page.name, str(page), 0)

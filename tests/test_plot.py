@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-matplotlib = pytest.importorskip("matplotlib")
+matplotlib = pytest.importorskip("matplotlib", reason="plots are optional: pip install 'lindstedt[plot]'")
 matplotlib.use("Agg")
 
 import lindstedt  # noqa: E402

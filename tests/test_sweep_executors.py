@@ -50,7 +50,7 @@ def test_thread_pool_reports_every_point_once(system):
 
 
 def test_progress_bar_counts_the_points(system, capsys):
-    pytest.importorskip("tqdm")
+    pytest.importorskip("tqdm", reason="the progress bar is optional: pip install 'lindstedt[dask]' (or tqdm)")
     results = lindstedt.nnm_sweep(system, 1, EPSILONS, modal_amplitude=1.0, progress=True)
     check(results)
     assert f"{len(EPSILONS)}/{len(EPSILONS)}" in capsys.readouterr().err
