@@ -10,6 +10,7 @@ wrong and how to fix it.  The hierarchy is deliberately small:
     ``OrderError`` (also a ``ValueError``): an expansion order out of range.
     ``ResonanceError``: an internal resonance makes the expansion undefined.
     ``ConvergenceError``: a numerical method did not reach its tolerance.
+    ``CodeGenerationError``: code could not be generated, compiled or loaded.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ __all__ = [
     "OrderError",
     "ResonanceError",
     "ConvergenceError",
+    "CodeGenerationError",
 ]
 
 
@@ -51,3 +53,7 @@ class ResonanceError(LindstedtError):
 
 class ConvergenceError(LindstedtError):
     """A numerical method (quadrature, series, Newton) failed to converge."""
+
+
+class CodeGenerationError(LindstedtError):
+    """The generated code could not be generated, compiled or loaded (e.g. an unknown target language)."""
