@@ -132,7 +132,7 @@ class NNMResult(JsonExport):
 
     @property
     def max_abs_multiplier(self) -> float | None:
-        """max |μ| over the Floquet multipliers (None when they were not computed)."""
+        """The largest ``|μ|`` of the Floquet multipliers (None when they were not computed)."""
         if self.floquet_multipliers is None or not np.size(self.floquet_multipliers):
             return None
         return float(np.max(np.abs(self.floquet_multipliers)))
