@@ -212,3 +212,30 @@ def format_error(x: float | None) -> str:
     if _missing(x):
         return "—"
     return "0" if x == 0 else f"{x:.1e}"
+
+
+def loglog_figure(path: Path, curves: Sequence[tuple[Sequence[float], Sequence[float], str]], *, title: str,
+                  x_label: str, y_label: str, notes: Sequence[str] = (), floor: float = 1e-17) -> None:
+    """A log–log figure (SVG, PNG... by the suffix of ``path``) on matplotlib: one line with a marker at every
+    point per curve (a one-point curve stays visible), dashed from the fifth curve on, the legend and ``notes``
+    in a panel right of the axes so that they never hide data; values below ``floor`` are drawn at ``floor``."""
+    from matplotlib.figure import Figure  # no pyplot: files only
+
+    figure = Figure(figsize=(10.5, 4.8), layout="constrained")
+    ax = figure.subplots()
+    markers = "osD^vPX*"
+    for index, (x, y, label) in enumerate(curves):
+        xs = [float(v) for v in x]
+        ys = [max(float(v), floor) for v in y]
+        ax.loglog(xs, ys, marker=markers[index % len(markers)], markersize=4, linewidth=1.4,
+                  linestyle="--" if index >= 4 else "-", label=label)
+    ax.set_title(title, fontsize=10)
+    ax.set_xlabel(x_label)
+    ax.set_ylabel(y_label)
+    ax.grid(True, which="major", linewidth=0.4, alpha=0.6)
+    legend = ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
+    if notes:
+        legend.set_title("\n".join(notes), prop={"size": 8})
+        legend._legend_box.align = "left"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    figure.savefig(path)

@@ -25,7 +25,6 @@ import argparse
 import json
 import math
 import os
-import re
 import statistics
 import subprocess
 import sys
@@ -44,6 +43,7 @@ from _common import (
     run_worker,
     write_json,
 )
+from _common import loglog_figure  # noqa: E402
 from _common import emit as _emit, format_error as _e, format_seconds as _t, per_call as _warm  # noqa: E402
 
 TITLE = "Contact laws (issue 12): time to ω4 per class, accuracy, and harmonic balance against the series"
@@ -395,52 +395,10 @@ def _fit_power(xs: list[float], ys: list[float]) -> float | None:
     return sum((x - mx) * (y - my) for x, y in pairs) / sum((x - mx) ** 2 for x, _ in pairs)
 
 
-_PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b")
-
-
 def _figure(path: Path, curves: list[tuple[list[float], list[float], str]], *, title: str, notes: list[str]) -> None:
-    """Log–log SVG via ``lindstedt.validate.line_plot_svg`` on log10 data, with a marker at every point and the
-    legend moved to a panel right of the plot (so it never hides data)."""
-    _use_this_tree()
-    from lindstedt.validate import line_plot_svg
-
-    width, height, panel, top = 680, 460, 330, 40
-    svg = line_plot_svg([([math.log10(max(v, 1e-300)) for v in x], [math.log10(max(v, PLOT_FLOOR)) for v in y], label)
-                         for x, y, label in curves],
-                        title=title, x_label="log10 run time (s)", y_label="log10 |ω − ω_exact|", log_y=False,
-                        width=width, height=height)
-    out, index = [], -1
-    for line in svg.splitlines():
-        if line.startswith("<svg ") or (line.startswith("<rect ") and index < 0):
-            line = line.replace(f'width="{width}"', f'width="{width + panel}"', 1)
-        elif line.startswith("<polyline"):
-            index += 1
-            colour = _PALETTE[index % len(_PALETTE)]
-            line = re.sub(r'stroke="#[0-9a-fA-F]{6}"', f'stroke="{colour}"', line)
-            if index >= 3:
-                line = line.replace('stroke-width="1.5"', 'stroke-width="1.5" stroke-dasharray="5,3"')
-            out.append(line)
-            for pair in re.search(r'points="([^"]*)"', line).group(1).split():
-                x, y = map(float, pair.split(","))
-                out.append(f'<circle cx="{x:.2f}" cy="{y:.2f}" r="3" fill="{colour}"/>')
-            continue
-        elif index >= 0 and line.startswith("<text") and 'text-anchor="end" fill=' in line:
-            colour = _PALETTE[index % len(_PALETTE)]
-            label = re.search(r">(.*)</text>", line).group(1)
-            y = top + 20 + 20 * index
-            dash = ' stroke-dasharray="5,3"' if index >= 3 else ""
-            out.append(f'<line x1="{width + 5}" y1="{y - 4}" x2="{width + 31}" y2="{y - 4}" stroke="{colour}" '
-                       f'stroke-width="1.5"{dash}/>')
-            out.append(f'<circle cx="{width + 18}" cy="{y - 4}" r="3" fill="{colour}"/>')
-            out.append(f'<text x="{width + 37}" y="{y}" fill="{colour}">{label}</text>')
-            continue
-        elif line == "</svg>":
-            for j, note in enumerate(notes):
-                out.append(f'<text x="{width + 5}" y="{top + 40 + 20 * (index + 1) + 16 * j}" fill="#555555" '
-                           f'font-size="11">{note}</text>')
-        out.append(line)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(out) + "\n")
+    """Error against run time, log–log (matplotlib, ``_common.loglog_figure``)."""
+    loglog_figure(path, curves, title=title, x_label="run time (s)", y_label="|ω − ω_exact|", notes=notes,
+                  floor=PLOT_FLOOR)
 
 
 def _tree_description() -> str:

@@ -19,8 +19,8 @@ with an independent exact reference at high precision:
 Every problem runs in its own fresh interpreter (this file doubles as its worker: ``python -I
 bench_method_pairs.py --worker NAME [--quick]`` prints one ``@@BENCH-RESULT {json}`` line).  Timing is
 ``time.perf_counter`` inside that process, minimum over repeats; what each time covers is stated in the
-section.  The figures are SVG files in ``benchmarks/figures/`` drawn with ``lindstedt.validate.line_plot_svg``
-(log10 taken here for log–log axes).
+section.  The figures are SVG files in ``benchmarks/figures/`` drawn on log–log axes with matplotlib
+(``_common.loglog_figure``).
 
 Standalone: ``python benchmarks/bench_method_pairs.py [--quick]`` prints the markdown section.
 """
@@ -31,7 +31,6 @@ import argparse
 import gc
 import json
 import math
-import re
 import sys
 import time
 from pathlib import Path
@@ -40,6 +39,7 @@ from typing import Any, Callable
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _common import BENCH_DIR, RESULT_MARKER, load_average, run_worker, write_json  # noqa: E402
+from _common import loglog_figure  # noqa: E402
 from _common import format_seconds as _t, per_call as _warm  # noqa: E402
 
 TITLE = "Method pairs: run time against error (LP expansion, closed forms, quadrature, shooting, DOP853)"
@@ -460,71 +460,17 @@ def _worker_main(name: str, quick: bool) -> None:
 
 
 # =================================================================================================================
-# parent side: figures and markdown (no lindstedt import except the SVG helper)
+# parent side: figures (matplotlib) and markdown (no lindstedt import)
 # =================================================================================================================
-_PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b")
-_MARKERS = ("circle", "square", "triangle", "diamond", "circle", "square", "triangle")
-
-
-def _log10(values: list[float], floor: float = 1e-300) -> list[float]:
-    return [math.log10(max(abs(v), floor)) for v in values]
-
-
-def _marker(shape: str, x: float, y: float, colour: str) -> str:
-    if shape == "square":
-        return f'<rect x="{x - 3:.2f}" y="{y - 3:.2f}" width="6" height="6" fill="{colour}"/>'
-    if shape == "triangle":
-        return f'<polygon points="{x:.2f},{y - 4:.2f} {x - 4:.2f},{y + 3:.2f} {x + 4:.2f},{y + 3:.2f}" fill="{colour}"/>'
-    if shape == "diamond":
-        return f'<polygon points="{x:.2f},{y - 4:.2f} {x - 4:.2f},{y:.2f} {x:.2f},{y + 4:.2f} {x + 4:.2f},{y:.2f}" fill="{colour}"/>'
-    return f'<circle cx="{x:.2f}" cy="{y:.2f}" r="3" fill="{colour}"/>'
-
-
 def _figure(path: Path, curves: list[tuple[list[float], list[float], str]], *, title: str, x_label: str,
             y_label: str, notes: list[str] = ()) -> None:
-    """Log–log SVG: ``line_plot_svg`` on log10 data, then post-processed here: a longer palette (dashed from
-    the fifth curve on), a marker at every point (a one-point curve is otherwise invisible) and the legend
-    moved into a panel right of the plot so that it never hides data; ``notes`` go under the legend."""
-    from lindstedt.validate import line_plot_svg
+    """Log–log figure (matplotlib, ``_common.loglog_figure``)."""
+    loglog_figure(path, curves, title=title, x_label=x_label, y_label=y_label, notes=notes, floor=PLOT_FLOOR)
 
-    width, height, margin_top, panel = 680, 460, 40, 330
-    svg = line_plot_svg([(list(map(float, x)), list(map(float, y)), label) for x, y, label in curves],
-                        title=title, x_label=x_label, y_label=y_label, log_y=False, width=width, height=height)
-    out, index = [], -1
-    for line in svg.splitlines():
-        if line.startswith("<svg "):
-            line = line.replace(f'width="{width}"', f'width="{width + panel}"', 1)
-        elif line.startswith("<rect ") and index < 0:
-            line = line.replace(f'width="{width}"', f'width="{width + panel}"', 1)
-        elif line.startswith("<polyline"):
-            index += 1
-            colour = _PALETTE[index % len(_PALETTE)]
-            line = re.sub(r'stroke="#[0-9a-f]{6}"', f'stroke="{colour}"', line)
-            dash = ' stroke-dasharray="5,3"' if index >= 4 else ""
-            line = line.replace('stroke-width="1.5"', f'stroke-width="1.5"{dash}')
-            out.append(line)
-            for pair in re.search(r'points="([^"]*)"', line).group(1).split():
-                x, y = map(float, pair.split(","))
-                out.append(_marker(_MARKERS[index % len(_MARKERS)], x, y, colour))
-            continue
-        elif index >= 0 and line.startswith("<text") and 'text-anchor="end" fill=' in line:
-            colour = _PALETTE[index % len(_PALETTE)]
-            label = re.search(r">(.*)</text>", line).group(1)
-            y_legend = margin_top + 20 + 20 * index
-            x0 = width + 5
-            dash = ' stroke-dasharray="5,3"' if index >= 4 else ""
-            out.append(f'<line x1="{x0}" y1="{y_legend - 4}" x2="{x0 + 26}" y2="{y_legend - 4}" stroke="{colour}" '
-                       f'stroke-width="1.5"{dash}/>')
-            out.append(_marker(_MARKERS[index % len(_MARKERS)], x0 + 13, y_legend - 4, colour))
-            out.append(f'<text x="{x0 + 32}" y="{y_legend}" fill="{colour}">{label}</text>')
-            continue
-        elif line == "</svg>":
-            for k, note in enumerate(notes):
-                out.append(f'<text x="{width + 5}" y="{margin_top + 40 + 20 * (index + 1) + 16 * k}" '
-                           f'fill="#555555" font-size="11">{note}</text>')
-        out.append(line)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(out) + "\n")
+
+def _floored(values: list[float], floor: float = 1e-300) -> list[float]:
+    """|v|, drawn at ``floor`` when it is 0 (log axes)."""
+    return [max(abs(v), floor) for v in values]
 
 
 def _span(values: list[Any], fmt: Callable[[Any], str] = str) -> str:
@@ -607,21 +553,21 @@ def _section_duffing(data: dict, quick: bool, figures: list[Path]) -> list[str]:
         lp = entry["lp"]
         orders = [r["order"] for r in lp]
         curves = [
-            (_log10([r["seconds_cold"] for r in lp]), _log10([r["error"] for r in lp]),
+            (_floored([r["seconds_cold"] for r in lp]), _floored([r["error"] for r in lp]),
              f"LP expand + .frequency, cold, N = {orders[0]}…{orders[-1]}"),
-            (_log10([r["seconds_eval"] for r in lp]), _log10([r["error"] for r in lp]),
+            (_floored([r["seconds_eval"] for r in lp]), _floored([r["error"] for r in lp]),
              f"LP .frequency(ε) only, warm, N = {orders[0]}…{orders[-1]}"),
-            (_log10([r["seconds_lambdified"] for r in lp]), _log10([r["error_lambdified"] for r in lp]),
+            (_floored([r["seconds_lambdified"] for r in lp]), _floored([r["error_lambdified"] for r in lp]),
              f"LP lambdified ω(ε), warm, N = {orders[0]}…{orders[-1]}"),
-            (_log10([r["seconds"] for r in entry["elliptic"]]), _log10([r["error"] for r in entry["elliptic"]]),
+            (_floored([r["seconds"] for r in entry["elliptic"]]), _floored([r["error"] for r in entry["elliptic"]]),
              "elliptic closed form, precision " + _span([r["precision"] for r in entry["elliptic"]])),
-            (_log10([r["seconds"] for r in entry["quadrature"]]), _log10([r["error"] for r in entry["quadrature"]]),
+            (_floored([r["seconds"] for r in entry["quadrature"]]), _floored([r["error"] for r in entry["quadrature"]]),
              "quadrature, precision " + _span([r["precision"] for r in entry["quadrature"]])),
-            (_log10([r["seconds"] for r in entry["dop853"]]), _log10([r["error"] for r in entry["dop853"]]),
+            (_floored([r["seconds"] for r in entry["dop853"]]), _floored([r["error"] for r in entry["dop853"]]),
              "DOP853, rtol " + _span([r["rtol"] for r in entry["dop853"]], _e0)),
         ]
         _figure(path, curves, title=f"Duffing frequency, ε = {key}: error vs run time" + (" (quick)" if quick else ""),
-                x_label="log10 run time (s)", y_label="log10 |ω − ω_ref|",
+                x_label="run time (s)", y_label="|ω − ω_ref|",
                 notes=["each curve: one point per order / precision / tolerance", "connected in that order"])
         figures.append(path)
         w += [f"![Duffing, ε = {key}: error against run time]({_rel(path)})", ""]
@@ -684,23 +630,23 @@ def _section_unilateral(data: dict, quick: bool, figures: list[Path]) -> list[st
         orders = [r["order"] for r in ex]
         shooting = entry["shooting"]
         curves = [
-            (_log10([r["seconds_cold"] for r in ex]), _log10([r["error"] for r in ex]),
+            (_floored([r["seconds_cold"] for r in ex]), _floored([r["error"] for r in ex]),
              f"expansion + .frequency, cold, N = {orders[0]}…{orders[-1]}"),
-            (_log10([r["seconds_eval"] for r in ex]), _log10([r["error"] for r in ex]),
+            (_floored([r["seconds_eval"] for r in ex]), _floored([r["error"] for r in ex]),
              f"expansion .frequency(ε) only, warm, N = {orders[0]}…{orders[-1]}"),
-            (_log10([r["seconds_lambdified"] for r in ex]), _log10([r["error_lambdified"] for r in ex]),
+            (_floored([r["seconds_lambdified"] for r in ex]), _floored([r["error_lambdified"] for r in ex]),
              f"expansion lambdified ω(ε), warm, N = {orders[0]}…{orders[-1]}"),
-            (_log10([r["seconds"] for r in entry["closed_form"]]), _log10([r["error"] for r in entry["closed_form"]]),
+            (_floored([r["seconds"] for r in entry["closed_form"]]), _floored([r["error"] for r in entry["closed_form"]]),
              "closed form, precision " + _span([r["precision"] for r in entry["closed_form"]])),
-            (_log10([r["seconds"] for r in shooting]), _log10([r["error"] for r in shooting], PLOT_FLOOR),
+            (_floored([r["seconds"] for r in shooting]), _floored([r["error"] for r in shooting], PLOT_FLOOR),
              "shooting nnm_point, tol " + _span([r["tol"] for r in shooting], _e0)),
-            (_log10([r["seconds"] for r in entry["dop853_restart"]]),
-             _log10([r["error"] for r in entry["dop853_restart"]], PLOT_FLOOR), "DOP853 restarted at switches, rtol " + _span([r["rtol"] for r in entry["dop853_restart"]], _e0)),
-            (_log10([r["seconds"] for r in entry["dop853_through"]]),
-             _log10([r["error"] for r in entry["dop853_through"]], PLOT_FLOOR), "DOP853 through the kink, rtol " + _span([r["rtol"] for r in entry["dop853_through"]], _e0)),
+            (_floored([r["seconds"] for r in entry["dop853_restart"]]),
+             _floored([r["error"] for r in entry["dop853_restart"]], PLOT_FLOOR), "DOP853 restarted at switches, rtol " + _span([r["rtol"] for r in entry["dop853_restart"]], _e0)),
+            (_floored([r["seconds"] for r in entry["dop853_through"]]),
+             _floored([r["error"] for r in entry["dop853_through"]], PLOT_FLOOR), "DOP853 through the kink, rtol " + _span([r["rtol"] for r in entry["dop853_through"]], _e0)),
         ]
         _figure(path, curves, title=f"Unilateral spring κ = 1/3, ε = {key}: error vs run time"
-                + (" (quick)" if quick else ""), x_label="log10 run time (s)", y_label="log10 |ω − ω_ref|",
+                + (" (quick)" if quick else ""), x_label="run time (s)", y_label="|ω − ω_ref|",
                 notes=["each curve: one point per order / precision / tolerance", "connected in that order"])
         figures.append(path)
         w += [f"![Unilateral spring, ε = {key}: error against run time]({_rel(path)})", ""]
@@ -812,26 +758,26 @@ def _section_nnm(data: dict, quick: bool, figures: list[Path]) -> list[str]:
              f"expansion is cheaper from about {math.ceil(exp_cost / (sum(shoot_costs) / len(shoot_costs)))} ε values on "
              "— where its ε³ error is acceptable.")
     path_eps = FIGURES_DIR / "method_pairs_nnm_error_vs_eps.svg"
-    curves = [([math.log10(e) for e in eps], _log10([p["expansion"][k]["error"] for p in points], PLOT_FLOOR),
+    curves = [(list(eps), _floored([p["expansion"][k]["error"] for p in points], PLOT_FLOOR),
                f"expansion order {k}") for k in orders]
-    curves += [([math.log10(e) for e in eps], _log10([p["shooting"][i]["error"] for p in points], PLOT_FLOOR),
+    curves += [(list(eps), _floored([p["shooting"][i]["error"] for p in points], PLOT_FLOOR),
                 f"shooting tol {t:.0e}" + (" (default)" if t == DEFAULT_SHOOTING_TOL else ""))
                for i, t in enumerate(tols)]
     _figure(path_eps, curves, title="3-dof chain, NNM mode 1: frequency error vs ε" + (" (quick)" if quick else ""),
-            x_label="log10 ε", y_label="log10 |ω − ω_ref|", notes=[f"errors exactly 0 drawn at {_e0(PLOT_FLOOR)}"])
+            x_label="ε", y_label="|ω − ω_ref|", notes=[f"errors exactly 0 drawn at {_e0(PLOT_FLOOR)}"])
     figures.append(path_eps)
     path_time = FIGURES_DIR / "method_pairs_nnm_error_vs_time.svg"
     chosen = [p for p in points if p["eps"] in (0.01, 0.1)] or points[-2:]
     curves = []
     for p in chosen:
-        curves.append((_log10([data["expansion"][k]["seconds_cold"] for k in orders]),
-                       _log10([p["expansion"][k]["error"] for k in orders], PLOT_FLOOR),
+        curves.append((_floored([data["expansion"][k]["seconds_cold"] for k in orders]),
+                       _floored([p["expansion"][k]["error"] for k in orders], PLOT_FLOOR),
                        f"expansion, orders {orders[0]}…{orders[-1]} (cold), ε = {p['eps']:g}"))
     for p in chosen:
-        curves.append((_log10([s["seconds"] for s in p["shooting"]]), _log10([s["error"] for s in p["shooting"]], PLOT_FLOOR),
+        curves.append((_floored([s["seconds"] for s in p["shooting"]]), _floored([s["error"] for s in p["shooting"]], PLOT_FLOOR),
                        f"shooting, tol {_e0(tols[0])}…{_e0(tols[-1])}, ε = {p['eps']:g}"))
     _figure(path_time, curves, title="3-dof chain, NNM mode 1: error vs run time" + (" (quick)" if quick else ""),
-            x_label="log10 run time (s)", y_label="log10 |ω − ω_ref|",
+            x_label="run time (s)", y_label="|ω − ω_ref|",
             notes=[f"errors exactly 0 drawn at {_e0(PLOT_FLOOR)}", "each curve: orders 1…3 or tolerances, in order"])
     figures.append(path_time)
     w += ["", f"![3-dof NNM: error against ε]({_rel(path_eps)})", "",
@@ -859,7 +805,7 @@ def run(quick: bool = False) -> str:
          f"expansions {config['cold_repeats']} repeats of one call (caches dropped and `gc.collect()` before each, "
          f"untimed); everything else {config['repeats']} repeats of a loop of ≥ 20 ms, per-call mean (the quadrature "
          f"and the 3-dof shooting: {max(2, config['repeats'] // 2)} and {config['repeats']} repeats of one call; the 3-dof "
-         "reference and DOP853 check: one call). Figures: log10 error against log10 run time (or ε), one point "
+         "reference and DOP853 check: one call). Figures: error against run time (or ε) on log–log axes, one point "
          "per setting (order, digits, tolerance).", ""]
     if "duffing" in results:
         w += _section_duffing(results["duffing"], quick, figures)

@@ -12,6 +12,7 @@ None) and returns the Axes; the data drawn are those of the package's results an
   solution side by side (seed fig. 2);
 * :func:`convergence` — max error against ε on log-log axes with the fitted slope
   (:class:`lindstedt.validate.ConvergenceFit`);
+* :func:`error_over_time` — |u_N(t) − u(t)| against t for expansions of several orders (the exact flow as u);
 * :func:`branch` — an NNM branch (:class:`lindstedt.NNMBranch`): frequency against the continuation parameter,
   stable points solid, unstable dashed, jumps across internal-resonance tongues marked;
 * :func:`nnm_orbit` — one NNM (:class:`lindstedt.NNMResult`) over a period of the exact flow: the orbit in
@@ -36,7 +37,7 @@ import numpy as np
 
 from ._errors import LindstedtError
 
-__all__ = ["backbone", "branch", "convergence", "nnm_orbit", "spectrum", "waveform"]
+__all__ = ["backbone", "branch", "convergence", "error_over_time", "nnm_orbit", "spectrum", "waveform"]
 
 
 def _pyplot() -> Any:
@@ -198,6 +199,44 @@ def convergence(fits: Any, *, labels: Sequence[str] | None = None, ax: Any = Non
         ax.loglog(epsilons, np.exp(fit.intercept) * epsilons**fit.slope, "-", color=f"C{index}")
     ax.set_xlabel(r"$\varepsilon$")
     ax.set_ylabel(r"max error on $[0, T_\varepsilon]$")
+    ax.legend()
+    return ax
+
+
+def error_over_time(expansions: Any, epsilon: float, t: Sequence[float], *, values: dict[str, Any] | None = None,
+                    ax: Any = None) -> Any:
+    """|u_N(t) − u(t)| against t (log scale) for one or several expansions of one problem, u the exact flow.
+
+    The reference is :func:`lindstedt.validate.reference_solution` (closed-form arcs for piecewise-linear f,
+    DOP853 otherwise), computed once; each expansion is labelled by its order.  Errors below 1e-16 are drawn at
+    1e-16 (the log scale has no zero).
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import lindstedt, lindstedt.plot
+    >>> orders = [lindstedt.expand("Max(0, u)", order=n, a0=1, omega0=1) for n in (0, 1)]
+    >>> ax = lindstedt.plot.error_over_time(orders, 0.1, [0.0, 5.0, 10.0])
+    >>> [line.get_label() for line in ax.get_lines()], ax.get_yscale()
+    (['order 0', 'order 1'], 'log')
+    """
+    from lindstedt.validate import reference_solution
+
+    ax = _axes(ax)
+    expansions = [expansions] if not isinstance(expansions, (list, tuple)) else list(expansions)
+    if not expansions:
+        raise LindstedtError("error_over_time needs at least one expansion")
+    times = np.asarray(t, dtype=float)
+    exact = reference_solution(expansions[-1], epsilon, times, values=values)
+    if not exact.success:
+        raise LindstedtError(f"the exact flow failed: {exact.message}")
+    for expansion in expansions:
+        error = np.abs(expansion.displacement(times, epsilon, values=values) - exact.displacement)
+        ax.semilogy(times, np.maximum(error, 1e-16), label=f"order {expansion.order}")
+    ax.set_xlabel("time $t$")
+    ax.set_ylabel(r"$|u_N(t) - u(t)|$")
+    ax.set_title(rf"error against the exact flow, $\varepsilon = {epsilon:g}$")
     ax.legend()
     return ax
 

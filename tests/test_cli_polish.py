@@ -137,12 +137,12 @@ def test_nothing_is_written_unasked(tmp_path, monkeypatch):
     assert main(["derive", "--list"]) == 0
     assert main(["expand", "u**3", "--order", "1", "--eps", "0.1", "--a0", "1", "--omega0", "1"]) == 0
     assert list(tmp_path.iterdir()) == []
-    assert main(["demo", "--figure", "x.svg"]) == 0 and calls[-1] == "x.svg"
+    assert main(["demo", "--figure", "x.png"]) == 0 and calls[-1] == "x.png"
 
 
 def test_default_outputs_are_git_ignored():
     ignored = (ROOT / ".gitignore").read_text(encoding="utf-8").split()
-    assert "out/" in ignored and "lindstedt-demo.svg" in ignored
+    assert "out/" in ignored and "lindstedt-demo.png" in ignored
 
 
 def test_packaging_metadata_and_markers():
@@ -162,3 +162,21 @@ def test_unencodable_terminal_names_the_plain_format():
         capture_output=True, text=True, timeout=120, check=False, env={**os.environ, "PYTHONIOENCODING": "ascii"},
     )
     assert result.returncode == 2 and result.stderr.startswith("error: ") and "--format plain" in result.stderr
+
+
+def test_demo_figure_is_drawn_by_the_plotting_api(tmp_path, capsys):
+    pytest.importorskip("matplotlib", reason="the demo's figure needs matplotlib: pip install 'lindstedt[plot]'")
+    path = tmp_path / "demo.png"
+    assert main(["demo", "--order", "1", "--figure", str(path)]) == 0
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and path.stat().st_size > 10_000
+    assert f"written to {path}" in capsys.readouterr().out
+
+
+def test_demo_figure_suffix_and_missing_matplotlib_are_named(tmp_path, capsys, monkeypatch):
+    pytest.importorskip("matplotlib", reason="the suffix is checked against matplotlib's formats")
+    assert main(["demo", "--order", "1", "--figure", str(tmp_path / "demo.xyz")]) == 2
+    assert "the suffix must name an image format" in capsys.readouterr().err
+    monkeypatch.setitem(sys.modules, "matplotlib.figure", None)  # as if matplotlib were not installed
+    assert main(["demo", "--order", "1", "--figure", str(tmp_path / "demo.png")]) == 2
+    assert "pip install 'lindstedt[plot]'" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []

@@ -56,6 +56,31 @@ def test_waveform_draws_the_closed_form_bilinear_orbit():
     assert np.max(np.abs(expansion_line.get_ydata() - closed_form)) < 0.05  # order 2 at ε = 0.3 over half a period
 
 
+def test_error_over_time_draws_the_distance_to_the_closed_form_bilinear_orbit():
+    # the same closed-form orbit of u'' + u + ε u_+ = 0 as above, over its first half period
+    epsilon = 0.05
+    k = math.sqrt(1 + epsilon)
+    t1 = math.pi / (2 * k)
+    times = np.linspace(0, t1 + math.pi, 61)
+    closed_form = np.where(times <= t1, np.cos(k * times), -k * np.sin(times - t1))
+    expansions = [lindstedt.expand("Max(0, u)", order=n, a0=1, omega0=1) for n in (0, 1, 2)]
+    ax = lindstedt.plot.error_over_time(expansions, epsilon, times)
+    assert ax.get_yscale() == "log" and [line.get_label() for line in ax.get_lines()] == ["order 0", "order 1", "order 2"]
+    for expansion, line in zip(expansions, ax.get_lines()):
+        drawn = line.get_ydata()
+        expected = np.maximum(np.abs(expansion.displacement(times, epsilon) - closed_form), 1e-16)
+        # the exact flow matches the closed form to ~1e-15; errors are compared where they exceed that by 1e3
+        large = expected > 1e-12
+        assert np.allclose(drawn[large], expected[large], rtol=1e-3)
+    maxima = [float(np.max(line.get_ydata())) for line in ax.get_lines()]
+    assert maxima[0] > maxima[1] > maxima[2]
+
+
+def test_error_over_time_needs_an_expansion():
+    with pytest.raises(lindstedt.LindstedtError, match="at least one"):
+        lindstedt.plot.error_over_time([], 0.1, [0.0, 1.0])
+
+
 def test_spectra_are_drawn_side_by_side_with_their_amplitudes():
     expansion = lindstedt.expand("Max(0, u)", order=3, a0=1, omega0=1)
     spectra = [expansion_spectrum(expansion, 0.2), exact_spectrum(expansion, 0.2)]

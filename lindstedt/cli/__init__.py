@@ -130,7 +130,8 @@ def build_parser() -> argparse.ArgumentParser:
     demo = commands.add_parser("demo", help="the tour: Duffing and u_+ expansions checked against exact references")
     demo.add_argument("--order", type=int, default=8, help="Duffing order to derive (default 8)")
     demo.add_argument("--figure", default=None, metavar="PATH",
-                      help="also write an SVG figure of the error of orders 0-2 to PATH, e.g. lindstedt-demo.svg (default: write nothing)")
+                      help="also draw the error of orders 0-2 against the exact flow into PATH (matplotlib; .png, .svg, .pdf...), "
+                           "e.g. lindstedt-demo.png (default: write nothing)")
     return parser
 
 

@@ -8,12 +8,14 @@
 3. A gap f = (u − 1/3)_+ to order 4, exact, against the Cauchy-integral
    Taylor coefficients of the exact piecewise-linear frequency.
 4. The waveform: order-2 expansion vs a DOP853 solution over t ∈ [0, 1/ε],
-   and (``figure_path``) an SVG of the error of orders 0, 1, 2 over time.
+   and (``figure_path``, matplotlib) a figure of the error of orders 0, 1, 2 over time against the exact
+   flow (:func:`lindstedt.plot.error_over_time`; PNG, SVG or PDF by the path's suffix).
 """
 
 from __future__ import annotations
 
 import time
+from typing import Any
 
 import mpmath
 import numpy as np
@@ -22,7 +24,6 @@ import sympy
 from ..methods.lindstedt_poincare import expand
 from ..references.duffing import duffing_frequency_taylor
 from ..references.piecewise import piecewise_linear_frequency_taylor, piecewise_linear_frequency_taylor_symbolic
-from ..export.svg import line_plot_svg
 
 __all__ = ["run_demo"]
 
@@ -39,6 +40,8 @@ def run_demo(order: int = 8, figure_path: str | None = None) -> str:
     >>> "Duffing" in run_demo(order=3)
     True
     """
+    if figure_path:
+        _figure_class(figure_path)  # a bad suffix or a missing matplotlib fails before the tour, not after it
     started = time.perf_counter()
     lines: list[str] = []
     a0, omega0 = sympy.Symbol("a0", positive=True), sympy.Symbol("omega0", positive=True)
@@ -117,32 +120,50 @@ def run_demo(order: int = 8, figure_path: str | None = None) -> str:
             error = float(np.max(np.abs(expansion.displacement(t, eps) - reference)))
             lines.append(f"     f = {text:16s} eps = {eps:<6} max error {error:.2e}   (eps^3 = {eps**3:.1e})")
 
-    if figure_path:
-        expansion = expand("Max(0, u - 1/3)", order=2, a0=1, omega0=1)
-        eps = 0.05
-        t = np.linspace(0, 1 / eps, 4000)
-
-        def field(_, state):
-            return [state[1], -state[0] - eps * max(0.0, state[0] - 1 / 3)]
-
-        from scipy.integrate import solve_ivp  # here, not at module level: import lindstedt stays light
-        reference = solve_ivp(field, (0, t[-1]), [1.0, 0.0], method="DOP853", t_eval=t, rtol=1e-12, atol=1e-14).y[0]
-        curves = []
-        for order in (0, 1, 2):
-            truncated = expand("Max(0, u - 1/3)", order=order, a0=1, omega0=1)
-            curves.append((t, np.abs(truncated.displacement(t, eps) - reference) + 1e-16, f"order {order}"))
-        svg = line_plot_svg(
-            curves,
-            title="u'' + u + 0.05 (u - 1/3)_+ = 0: |expansion - exact| over t in [0, 1/eps]",
-            x_label="t",
-            y_label="error",
-            log_y=True,
-        )
-        with open(figure_path, "w", encoding="utf-8") as handle:
-            handle.write(svg)
-        lines.append("")
-        lines.append(f"Figure (error of orders 0, 1, 2 against the exact solution) written to {figure_path}")
-
     lines.append("")
+    if figure_path:
+        _write_figure(figure_path)
+        lines.append(f"Figure (error of orders 0, 1, 2 against the exact flow) written to {figure_path}")
+    elif _has_matplotlib():
+        lines.append("Figures: `lindstedt demo --figure demo.png` draws the error of orders 0-2 (lindstedt.plot).")
+    else:
+        lines.append("Figures: pip install 'lindstedt[plot]' (matplotlib), then `lindstedt demo --figure demo.png`.")
+
     lines.append(f"Tour finished in {time.perf_counter() - started:.1f} s.  Next: `lindstedt expand --help`.")
     return "\n".join(lines)
+
+
+def _has_matplotlib() -> bool:
+    import importlib.util
+
+    return importlib.util.find_spec("matplotlib") is not None
+
+
+def _figure_class(figure_path: str) -> Any:
+    """matplotlib's Figure, once the path's suffix is known to be a format it writes (typed errors otherwise)."""
+    from .._errors import LindstedtError
+
+    try:
+        from matplotlib.figure import Figure  # no pyplot: a file is asked for, never a window
+    except ImportError as error:
+        raise LindstedtError("--figure needs matplotlib: pip install 'lindstedt[plot]'") from error
+    formats = Figure().canvas.get_supported_filetypes()
+    suffix = figure_path.rsplit(".", 1)[-1].lower() if "." in figure_path else ""
+    if suffix not in formats:
+        raise LindstedtError(f"--figure {figure_path!r}: the suffix must name an image format, one of "
+                             f"{', '.join('.' + name for name in sorted(formats))} (e.g. demo.png)")
+    return Figure
+
+
+def _write_figure(figure_path: str) -> None:
+    """The error of orders 0, 1, 2 of u'' + u + ε (u − 1/3)_+ = 0 against the exact flow, ε = 0.05, t ∈ [0, 1/ε]."""
+    from .. import plot
+
+    Figure = _figure_class(figure_path)
+    eps = 0.05
+    t = np.linspace(0, 1 / eps, 4000)
+    figure = Figure(figsize=(7, 4), layout="tight")
+    ax = figure.subplots()
+    plot.error_over_time([expand("Max(0, u - 1/3)", order=order, a0=1, omega0=1) for order in (0, 1, 2)], eps, t, ax=ax)
+    ax.set_title(r"$u'' + u + 0.05\,(u - 1/3)_+ = 0$: error against the exact flow")
+    figure.savefig(figure_path)

@@ -150,7 +150,7 @@ class ForcedOscillator:
     def is_numeric(self) -> bool:
         """True when ω0, ζ, F and every parameter of f are numbers (what the exact numerics need)."""
         return not (self.nonlinearity.free_symbols - {self.oscillator.variable}) and all(
-            not sympy.sympify(value).free_symbols for value in (self.omega0, self.zeta, self.forcing)
+            not value.free_symbols for value in (self.omega0, self.zeta, self.forcing)
         )
 
     def numeric_coefficients(self) -> tuple[float, float, float]:
@@ -163,7 +163,7 @@ class ForcedOscillator:
         """
         names = sorted(str(symbol) for symbol in self.nonlinearity.free_symbols - {self.oscillator.variable})
         for name, value in (("omega0", self.omega0), ("zeta", self.zeta), ("forcing", self.forcing)):
-            if sympy.sympify(value).free_symbols:
+            if value.free_symbols:
                 names.append(name)
         if names:
             raise ParameterError(

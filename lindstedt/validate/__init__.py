@@ -36,9 +36,7 @@ Spectra (:mod:`lindstedt.validate.spectra`; also exported by :mod:`lindstedt`)
     its own ω(ε), :func:`exact_spectrum` the true solution over its exact
     period :func:`exact_period`.
 
-Plots
-    :func:`line_plot_svg`: a dependency-free SVG line plot (error curves of
-    ``lindstedt demo`` and of the benchmarks).
+Figures of all of these are drawn by :mod:`lindstedt.plot` (matplotlib, optional).
 
 Every numerical result is a frozen dataclass with ``success``, ``message``
 and counters (samples, reference solves, switches, right-hand-side or gap
@@ -56,7 +54,6 @@ Examples
 2.0
 """
 
-from ..export.svg import line_plot_svg
 from .contact import ContactMeasure, ContactMeasureFit, contact_measure, fitted_contact_measure_order
 from .errors import (
     ConvergenceFit,
@@ -93,5 +90,4 @@ __all__ = [
     "exact_spectrum",
     "exact_period",
     "ExactPeriod",
-    "line_plot_svg",
 ]
