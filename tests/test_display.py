@@ -122,3 +122,41 @@ def test_stretched_arc_latex_and_repr():
     assert arc._repr_latex_() == latex
     text = repr(arc)
     assert "length=[1.570796327, -0.3594420704]" in text and "<2 orders x 64 coefficients" in text and len(text) < 500
+
+
+@pytest.fixture(scope="module")
+def validation_results():
+    import lindstedt.validate as validate
+
+    expansion = lindstedt.expand("Max(0, u)", order=2, a0=1, omega0=1)
+    problem = lindstedt.Oscillator("u**3", a0=1, omega0=1)
+    return [
+        validate.exact_period(problem, 0.1),
+        validate.expansion_error(expansion, 0.1, 10.0),
+        validate.fitted_convergence_order(expansion, [0.01, 0.02, 0.04]),
+        validate.reference_solution(expansion, 0.1, [0.0, 1.0, 2.0]),
+        validate.expansion_spectrum(expansion, 0.1),
+        validate.contact_measure(np.cos(np.linspace(0, 10, 201)), np.linspace(0, 10, 201), 0.1),
+    ]
+
+
+def test_every_validation_result_has_a_short_labelled_repr_and_an_html_table(validation_results):
+    for result in validation_results:
+        name = type(result).__name__
+        text = repr(result)
+        assert text.startswith(f"{name}(") and "success=True" in text, name
+        assert "array(" not in text and "mpf(" not in text, f"{name}: raw array/mpf in the repr"
+        assert len(text) < 2500, f"{name}: repr of {len(text)} characters"
+        html = result._repr_html_()
+        assert html.startswith('<table class="lindstedt">') and f"{name}: success" in html, name
+        assert "<th" in html and "message" in html, name
+
+
+def test_generated_code_shows_its_source_in_a_notebook_and_cuts_it_in_the_repr():
+    expansion = lindstedt.expand("u**3", order=1, a0=1, omega0=1)
+    for language, fence in (("numpy", "python"), ("octave", "matlab"), ("rust", "rust")):
+        code = lindstedt.generate_code(expansion, "frequency", language)
+        markdown = code._repr_markdown_()
+        assert f"```{fence}\n{code.source.rstrip()}\n```" in markdown
+        assert code.accuracy in markdown
+        assert code.source not in repr(code) and f"{len(code.source.splitlines())} lines" in repr(code)

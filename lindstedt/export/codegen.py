@@ -106,6 +106,30 @@ class GeneratedCode:
     source: str
     accuracy: str = "not analysed: the expression is printed as it is"
 
+    def __repr__(self) -> str:
+        """Labelled fields with the source cut (the whole source is ``.source``)."""
+        from .display import labelled_repr
+
+        return labelled_repr("GeneratedCode", [
+            ("language", repr(self.language)), ("quantity", repr(self.quantity)),
+            ("function_name", repr(self.function_name)), ("arguments", repr(self.arguments)),
+            ("source", f"<{len(self.source.splitlines())} lines; print(code.source)>"), ("accuracy", repr(self.accuracy)),
+        ])
+
+    def _repr_markdown_(self) -> str:
+        """Jupyter's rendering: the accuracy statement and the source, highlighted as its language.
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> code = lindstedt.generate_code(lindstedt.expand("u**3", order=1, a0=1, omega0=1), "frequency", "julia")
+        >>> code._repr_markdown_().splitlines()[2]
+        '```julia'
+        """
+        fence = {"numpy": "python", "jax": "python", "octave": "matlab"}.get(self.language, self.language)
+        return (f"**{self.function_name}** ({self.language}, {self.quantity}; arguments {', '.join(self.arguments)})\n\n"
+                f"```{fence}\n{self.source.rstrip()}\n```\n\n*Accuracy:* {self.accuracy}\n")
+
     def compile(self) -> Callable[..., np.ndarray]:
         """A Python callable running the generated code (C is built with ``cc``).
 

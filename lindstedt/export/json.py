@@ -57,6 +57,8 @@ import mpmath
 import numpy as np
 import sympy
 
+from .display import format_number, format_vector, html_table, labelled_repr, shorten
+
 __all__ = ["JsonExport", "exported_fields", "finite_float", "to_jsonable"]
 
 
@@ -178,8 +180,45 @@ def to_jsonable(value: Any) -> Any:
     raise TypeError(f"to_jsonable cannot convert a {type(value).__name__}; give the result a to_dict() or a JSON rule here")
 
 
+def display_value(value: Any) -> str:
+    """A field of a result as short text for people: numbers to 10 digits, vectors cut to 8 entries,
+    nested results and problems by name, long text shortened (see :mod:`lindstedt.export.display`).
+
+    Examples
+    --------
+    >>> display_value(np.linspace(0, 1, 30)), display_value(mpmath.mpf(1) / 3), display_value("ok")
+    ('[0, 0.0344828, 0.0689655, 0.103448, 0.137931, 0.172414, 0.206897, 0.241379, … (30 entries)]', '0.3333333333', "'ok'")
+    """
+    if isinstance(value, str):
+        return repr(value)
+    if value is None or isinstance(value, (bool, int, float, complex, mpmath.mpf, mpmath.mpc, np.generic)):
+        return format_number(value)
+    if isinstance(value, np.ndarray):
+        if value.ndim == 0:
+            return format_number(value)
+        return format_vector(value) + (f" (shape {value.shape})" if value.ndim > 1 else "")
+    if isinstance(value, enum.Enum):
+        return str(value.value)
+    describe = getattr(value, "describe", None)
+    if callable(describe) and not isinstance(value, type):  # a problem: its equation
+        return shorten(f"{type(value).__name__}: {describe()}", 160)
+    if isinstance(value, JsonExport) or (dataclasses.is_dataclass(value) and not isinstance(value, type)):
+        return f"{type(value).__name__}(…)"
+    if isinstance(value, Mapping):
+        return f"{{… {len(value)} entries}}" if value else "{}"
+    if isinstance(value, (list, tuple)):
+        if all(isinstance(item, (int, float, mpmath.mpf, np.generic)) and not isinstance(item, bool) for item in value):
+            return format_vector(value)
+        if value and all(isinstance(item, JsonExport) for item in value):
+            return f"[{len(value)} × {type(value[0]).__name__}]"
+        return shorten(str([display_value(item) for item in value[:8]]), 160)
+    return shorten(str(value), 160)
+
+
 class JsonExport:
-    """Mixin giving a result dataclass ``to_dict()`` and ``to_json()`` through :func:`to_jsonable`.
+    """Mixin giving a result dataclass ``to_dict()`` and ``to_json()`` through :func:`to_jsonable`, and the
+    displays for people: a labelled ``__repr__`` and Jupyter's ``_repr_html_`` table of the exported fields
+    (a dataclass keeps them when declared with ``repr=False``; a result may override ``_display_rows``).
 
     The class names its schema in ``SCHEMA = "lindstedt.<name>/1"``; the
     dictionary is ``{"schema": SCHEMA, <field>: to_jsonable(value), ...}`` in
@@ -207,3 +246,23 @@ class JsonExport:
     def to_json(self, indent: int | None = 2) -> str:
         """Strict JSON text of :meth:`to_dict` (``allow_nan=False``: never NaN)."""
         return json.dumps(self.to_dict(), indent=indent, allow_nan=False)
+
+    def _display_rows(self, quoted: bool = True) -> list[tuple[str, str]]:
+        """(label, text) of every exported field that the dataclass shows (``field(repr=False)`` hides one)."""
+        rows = []
+        for item in exported_fields(self):
+            if not item.repr:
+                continue
+            value = getattr(self, item.name)
+            rows.append((item.name, display_value(value) if quoted or not isinstance(value, str) else value))
+        return rows
+
+    def __repr__(self) -> str:
+        """``Name(field=value, …)`` with short values (numbers to 10 digits, vectors cut)."""
+        return labelled_repr(type(self).__name__, self._display_rows())
+
+    def _repr_html_(self) -> str:
+        """Jupyter's rendering: a two-column table of the fields."""
+        success = getattr(self, "success", None)
+        state = "" if success is None else (": success" if success else ": FAILED")
+        return html_table(f"{type(self).__name__}{state}", self._display_rows(quoted=False))

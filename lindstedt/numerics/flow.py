@@ -97,7 +97,7 @@ _CLUSTER_RTOL = 1e-9
 # --------------------------------------------------------------------------- #
 # results
 # --------------------------------------------------------------------------- #
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SwitchEvent(JsonExport):
     """A switch of one unilateral spring.
 

@@ -28,7 +28,7 @@ from .solutions import _as_positive, _numeric_problem, _require_expansion, refer
 __all__ = ["ContactMeasure", "contact_measure", "ContactMeasureFit", "fitted_contact_measure_order"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class ContactMeasure(JsonExport):
     """``μ(T) = |{t ∈ [t_0, T] : min_j |u(t) − b_j| ≤ threshold}|``.
 
@@ -217,7 +217,7 @@ def contact_measure(
     )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class ContactMeasureFit(JsonExport):
     """Slope of ``log(μ_ε(T)/T)`` against ``log ε`` on true solutions.
 

@@ -83,7 +83,7 @@ _ROUNDING_FLOOR = 1e3 * np.finfo(float).eps
 # --------------------------------------------------------------------------- #
 # log-log fits
 # --------------------------------------------------------------------------- #
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class LogLogFit(JsonExport):
     """Least-squares line ``log y = slope · log x + intercept``.
 
@@ -158,7 +158,7 @@ def _as_epsilons(epsilons: Sequence[float]) -> np.ndarray:
 # --------------------------------------------------------------------------- #
 # expansion error
 # --------------------------------------------------------------------------- #
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class ExpansionError(JsonExport):
     """``e(t) = u_N(t) − u(t)`` on a uniform grid of ``[0, t_end]``.
 
@@ -377,7 +377,7 @@ def _t_end_function(rule: str | Callable[[float], float], constant: float) -> tu
     return (lambda eps: constant * base(eps)), f"{constant:g}*{rule}"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class ConvergenceFit(JsonExport):
     """Slope of ``log max_{[0, t_end(ε)]} |u_N − u|`` against ``log ε``.
 
@@ -514,7 +514,7 @@ def fitted_convergence_order(
 # --------------------------------------------------------------------------- #
 # validity exponent
 # --------------------------------------------------------------------------- #
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class ValidityFit(JsonExport):
     """Exponent p of the validity time ``T_ε ~ ε^p``.
 

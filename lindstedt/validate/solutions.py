@@ -178,7 +178,7 @@ def _initial_displacement(source: Oscillator | Expansion, numeric: _NumericProbl
 # --------------------------------------------------------------------------- #
 # reference solution
 # --------------------------------------------------------------------------- #
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class ReferenceSolution(JsonExport):
     """The true solution of ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = u0``, ``u'(0) = v0`` (0 unless the problem has v0).
 
@@ -449,7 +449,7 @@ def reference_solution(
 # --------------------------------------------------------------------------- #
 # exact period
 # --------------------------------------------------------------------------- #
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class ExactPeriod(JsonExport):
     """Exact period of the true solution.
 

@@ -57,7 +57,7 @@ DEFAULT_PEAK_FLOOR = -10.0
 _LOG_FLOOR = -300.0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SpectralPeak(JsonExport):
     """One line of the spectrum.
 
@@ -87,7 +87,7 @@ class SpectralPeak(JsonExport):
     log10_relative: float
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Spectrum(JsonExport):
     """One-sided amplitude spectrum of uniformly sampled data.
 
