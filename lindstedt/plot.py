@@ -63,9 +63,12 @@ def backbone(
     omega0: float = 1,
     params: dict[str, Any] | None = None,
     reference: bool = True,
+    executor: Any = None,
+    progress: Any = None,
     ax: Any = None,
 ) -> Any:
-    """ω(a0) at ε from the series truncated at orders 1…``order``, and the exact frequency.
+    """ω(a0) at ε from the series truncated at orders 1…``order``, and the exact frequency
+    (the data of :func:`lindstedt.validate.backbone`).
 
     Parameters
     ----------
@@ -79,6 +82,8 @@ def backbone(
         Highest order drawn (one curve per order 1…order).
     reference : bool
         Also draw the exact frequency (energy-integral quadrature, 20 digits).
+    executor, progress
+        Run the amplitudes on an executor, with progress (see :func:`lindstedt.validate.backbone`).
 
     Examples
     --------
@@ -89,19 +94,17 @@ def backbone(
     >>> [line.get_label() for line in ax.get_lines()]
     ['order 1', 'order 2', 'exact']
     """
-    import lindstedt
-    from lindstedt.references import conservative_frequency
+    from lindstedt.validate import backbone as backbone_sweep
 
     ax = _axes(ax)
-    amplitudes = np.asarray(amplitudes, dtype=float)
-    series = [lindstedt.expand(f, order=order, a0=a0, omega0=omega0, params=params).omega for a0 in amplitudes]
-    for n in range(1, order + 1):
-        values = [sum(float(omega[k]) * epsilon**k for k in range(n + 1)) for omega in series]
-        ax.plot(amplitudes, values, label=f"order {n}")
+    curve = backbone_sweep(f, amplitudes, epsilon, order=order, omega0=omega0, params=params, reference=reference,
+                           executor=executor, progress=progress)
+    if not curve.success:
+        raise LindstedtError(f"the backbone failed: {curve.message}")
+    for n, values in zip(curve.orders, curve.series_frequencies):
+        ax.plot(curve.amplitudes, values, label=f"order {n}")
     if reference:
-        expression = lindstedt.Oscillator(f, a0=1, omega0=omega0, params=params).nonlinearity  # the one parser
-        exact = [float(conservative_frequency(expression, epsilon, a0=a0, omega0=omega0, precision=20)[0]) for a0 in amplitudes]
-        ax.plot(amplitudes, exact, "k--", label="exact")
+        ax.plot(curve.amplitudes, curve.exact_frequencies, "k--", label="exact")
     ax.set_xlabel("amplitude $a_0$")
     ax.set_ylabel(r"frequency $\omega$")
     ax.set_title(rf"backbone at $\varepsilon = {epsilon:g}$")

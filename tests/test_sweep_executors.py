@@ -73,3 +73,90 @@ def test_process_pools_pickle_the_task(system):
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
         check(lindstedt.nnm_sweep(system, 1, EPSILONS, modal_amplitude=1.0, executor=client.get_executor()))
+
+
+# --------------------------------------------------------------------------- backbone on an amplitude grid
+AMPLITUDES = [0.5, 1.0, 1.5]
+
+
+def check_duffing_backbone(curve, epsilon: float = 0.1) -> None:
+    """Against the complete-elliptic-integral frequency of u'' + u + ε u³ = 0 (an independent exact reference)."""
+    from lindstedt.references import duffing_exact_frequency
+
+    assert curve.success and curve.orders == (1, 2, 3)
+    exact = [float(duffing_exact_frequency(epsilon, amplitude=a, precision=30)) for a in AMPLITUDES]
+    assert curve.exact_frequencies == pytest.approx(exact, rel=1e-15)
+    assert all(estimate < 1e-18 for estimate in curve.exact_error_estimates)
+    errors = curve.errors
+    assert (errors[2] < errors[1]).all() and (errors[1] < errors[0]).all()  # each order closer to the exact backbone
+    # the truncated series at order 1 is 1 + 3ε a0²/8 (textbook)
+    assert curve.series_frequencies[0] == pytest.approx([1 + 3 * epsilon * a * a / 8 for a in AMPLITUDES], rel=1e-15)
+
+
+def test_backbone_serial_and_on_executors_agree_with_the_elliptic_reference():
+    from lindstedt.validate import backbone
+
+    serial = backbone("u**3", AMPLITUDES, 0.1, order=3)
+    check_duffing_backbone(serial)
+    seen = []
+    with ThreadPoolExecutor(2) as pool:
+        threaded = backbone("u**3", AMPLITUDES, 0.1, order=3, executor=pool, progress=lambda i, a, outcome: seen.append(i))
+    check_duffing_backbone(threaded)
+    assert sorted(seen) == [0, 1, 2]
+    assert (threaded.series_frequencies == serial.series_frequencies).all()
+
+
+def test_backbone_of_the_bilinear_spring_is_flat_at_the_closed_form():
+    from lindstedt.validate import backbone
+
+    curve = backbone("Max(0, u)", AMPLITUDES, 0.4, order=2)
+    assert curve.exact_frequencies == pytest.approx([bilinear_frequency(0.4)] * 3, rel=1e-15)
+
+
+def test_backbone_bad_input_names_the_fix():
+    from lindstedt.validate import backbone
+
+    with pytest.raises(lindstedt.ProblemError, match="positive finite release amplitudes"):
+        backbone("u**3", [0.0, 1.0], 0.1)
+    with pytest.raises(lindstedt.ProblemError, match="epsilon"):
+        backbone("u**3", [1.0], -0.1)
+    with pytest.raises(lindstedt.ProblemError, match="order"):
+        backbone("u**3", [1.0], 0.1, order=0)
+
+
+def test_backbone_on_a_dask_cluster_of_processes():
+    # the amplitude task is pickled to worker processes
+    distributed = pytest.importorskip("distributed", reason="Dask is optional: pip install 'lindstedt[dask]'")
+    from lindstedt.validate import backbone
+
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        check_duffing_backbone(backbone("u**3", AMPLITUDES, 0.1, order=3, executor=client.get_executor()))
+
+
+def test_backbone_table():
+    pytest.importorskip("pandas", reason="tables are optional: pip install 'lindstedt[pandas]'")
+    from lindstedt.validate import backbone
+
+    table = backbone("u**3", AMPLITUDES, 0.1, order=3).to_dataframe()
+    assert list(table["a0"]) == AMPLITUDES and len(table.columns) == 6
+
+
+def test_fitted_orders_on_a_process_pool_equal_the_serial_fits():
+    # the per-ε reference solves are independent tasks; a pool must give the same numbers and counters
+    from lindstedt.validate import fitted_convergence_order, fitted_validity_exponent
+
+    expansion = lindstedt.expand("Max(0, u - 1/3)", order=1, a0=1, omega0=1)
+    serial = fitted_convergence_order(expansion, [0.04, 0.02, 0.01])
+    seen = []
+    with ProcessPoolExecutor(2) as pool:
+        pooled = fitted_convergence_order(expansion, [0.04, 0.02, 0.01], executor=pool, progress=lambda i, w, r: seen.append(i))
+        grazing = lindstedt.expand("Max(0, u - 1)", order=1, a0=1, omega0=1)
+        validity_serial = fitted_validity_exponent(grazing, [0.02, 0.01, 0.005], a1=1.0)
+        validity_pooled = fitted_validity_exponent(grazing, [0.02, 0.01, 0.005], a1=1.0, executor=pool)
+    assert sorted(seen) == [0, 1, 2]
+    assert serial.success and pooled.success and abs(serial.slope - 2) < 0.15  # order 1: slope N + 1 = 2
+    assert (pooled.max_errors == serial.max_errors).all() and pooled.n_reference_solves == serial.n_reference_solves == 3
+    assert validity_serial.success and abs(validity_serial.exponent + 0.5) < 0.15  # grazing: T ~ ε^(-1/2)
+    assert (validity_pooled.validity_times == validity_serial.validity_times).all()
+    assert validity_pooled.n_reference_solves == validity_serial.n_reference_solves

@@ -67,6 +67,7 @@ from typing import Any
 import numpy as np
 
 from .._errors import ProblemError
+from .._sweep import sweep_map
 from ..problems.system import UnilateralSystem
 from .results import ContinuationProgress, NNMBranch, NNMResult, _branch_events
 from .sensitivity import _check_epsilon, _integrate
@@ -1052,38 +1053,4 @@ def nnm_sweep(
     _check_parameter(parameter, epsilon, "sweeps")
     values = [float(v) for v in values]
     task = partial(_sweep_task, system=system, mode=mode, parameter=parameter, epsilon=epsilon, options=options)
-    report, close = _progress_reporter(progress, len(values))
-    results: list[NNMResult | None] = [None] * len(values)
-    try:
-        if executor is None:
-            for index, value in enumerate(values):
-                results[index] = task(value)
-                report(index, value, results[index])
-        else:
-            from concurrent.futures import as_completed
-
-            futures = {executor.submit(task, value): index for index, value in enumerate(values)}
-            for future in as_completed(futures):
-                index = futures[future]
-                results[index] = future.result()
-                report(index, values[index], results[index])
-    finally:
-        close()
-    return results  # type: ignore[return-value]  # every entry is filled
-
-
-def _progress_reporter(progress: Any, total: int) -> tuple[Callable[[int, float, NNMResult], Any], Callable[[], Any]]:
-    """(report, close) for :func:`nnm_sweep`'s ``progress``: nothing, a user callable, or a tqdm bar."""
-    if progress is None or progress is False:
-        return (lambda *_: None), (lambda: None)
-    if callable(progress):
-        return progress, (lambda: None)
-    try:
-        from tqdm.auto import tqdm
-    except ImportError:
-        import warnings
-
-        warnings.warn("progress=True needs tqdm: pip install tqdm (no progress bar shown)", stacklevel=3)
-        return (lambda *_: None), (lambda: None)
-    bar = tqdm(total=total, desc="nnm_sweep", unit="point")
-    return (lambda *_: bar.update(1)), bar.close
+    return sweep_map(task, values, executor=executor, progress=progress, description="nnm_sweep")

@@ -483,12 +483,7 @@ def to_dataframe(results: Sequence[NNMResult]) -> Any:
     >>> to_dataframe(points)[["epsilon", "frequency"]].round(6).values.tolist()
     [[0.1, 1.023823], [0.2, 1.045549]]
     """
-    try:
-        import pandas
-    except ImportError as error:
-        from .._errors import LindstedtError
-
-        raise LindstedtError("tables need pandas: pip install pandas (or pip install 'lindstedt[pandas]')") from error
+    from ..export.tables import dataframe
 
     rows = [
         {
@@ -500,6 +495,6 @@ def to_dataframe(results: Sequence[NNMResult]) -> Any:
         }
         for result in results
     ]
-    return pandas.DataFrame(rows, columns=["success", "frequency", "period", "epsilon", "energy", "modal_amplitude", "stable",
+    return dataframe(rows, columns=["success", "frequency", "period", "epsilon", "energy", "modal_amplitude", "stable",
                                            "max_abs_multiplier", "residual", "n_switches", "mode_share", "newton_iterations",
                                            "flow_evaluations", "message"])

@@ -534,6 +534,23 @@ class Expansion:
     order: int
     _hierarchy: SmoothHierarchy | BranchHierarchy = field(repr=False, compare=False)
     _form: NormalForm | PiecewiseNormalForm = field(repr=False, compare=False)
+    #: (precision, numeric) of the LindstedtPoincare that derived it: how a process that unpickles it re-derives it
+    _method: tuple[int, bool] = field(default=(30, False), repr=False, compare=False)
+
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        """Pickled as its recipe (problem, order, method): the receiving process re-derives it (lazily, cached
+        there), so expansions travel to process pools and Dask workers.
+
+        Examples
+        --------
+        >>> import pickle, lindstedt
+        >>> e = lindstedt.expand("Max(0, u - 1/3)", order=2, a0=1, omega0=1)
+        >>> pickle.loads(pickle.dumps(e)).omega == e.omega
+        True
+        """
+        from ..methods.lindstedt_poincare import _rebuild_expansion
+
+        return _rebuild_expansion, (self.problem, self.order, *self._method)
 
     @property
     def is_piecewise(self) -> bool:

@@ -29,6 +29,10 @@ Contact measure, Lemma 3.2 (:mod:`lindstedt.validate.contact`)
     :func:`fitted_contact_measure_order` (:class:`ContactMeasureFit`): the
     slope of ``log(μ_ε(T)/T)`` against ``log ε`` (1, or 1/2 at grazing).
 
+Backbone (:mod:`lindstedt.validate.backbone`)
+    :func:`backbone` (:class:`Backbone`): ω(a0) on an amplitude grid, the series truncated at every
+    order against the exact frequency (energy-integral quadrature), serially or on any executor.
+
 Spectra (:mod:`lindstedt.validate.spectra`; also exported by :mod:`lindstedt`)
     :func:`spectrum` (:class:`Spectrum` of :class:`SpectralPeak` lines): the
     line spectrum ``|c_0|, |c_k − i s_k|`` of a periodic signal sampled over
@@ -54,6 +58,7 @@ Examples
 2.0
 """
 
+from .backbone import Backbone, backbone
 from .contact import ContactMeasure, ContactMeasureFit, contact_measure, fitted_contact_measure_order
 from .errors import (
     ConvergenceFit,
@@ -90,4 +95,6 @@ __all__ = [
     "exact_spectrum",
     "exact_period",
     "ExactPeriod",
+    "backbone",
+    "Backbone",
 ]

@@ -43,11 +43,13 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
 from .._errors import ProblemError
+from .._sweep import MPMATH_LOCK, sweep_map
 from ..export.json import JsonExport
 from ..results.accuracy import ExpansionValidityWarning
 from ..problems.oscillator import Oscillator
@@ -334,23 +336,69 @@ def expansion_error(
     )
 
 
+def _error_task(window: tuple[float, float], *, expansion: Expansion, omega0: float, samples_per_period: int,
+                options: dict[str, Any]) -> ExpansionError:
+    """:func:`expansion_error` over ``window = (ε, t_end)`` (module level: picklable for process pools)."""
+    eps, t_end = window
+    with MPMATH_LOCK:  # exact repairs of the compiled expansion set mpmath's process-wide precision
+        return expansion_error(expansion, eps, t_end, _default_samples(t_end, omega0, samples_per_period), **options)
+
+
+def _validity_task(window: tuple[float, float, float], *, period: float, **run: Any) -> tuple[float | None, float, list[ExpansionError]]:
+    """The first time ρ exceeds the threshold at one ε: windows from 16 P0, doubled up to ``t_max``.
+
+    Returns (the time or None, the last window, the error runs made).
+    """
+    eps, threshold, t_max = window
+    span = min(16 * period, t_max)
+    runs = []
+    while True:
+        result = _error_task((eps, span), **run)
+        runs.append(result)
+        if not result.success:
+            return None, span, runs
+        found = _first_exceedance(result.times, result.phase_error, threshold)
+        if found is not None or span >= t_max:
+            return found, span, runs
+        span = min(2 * span, t_max)
+
+
 class _ErrorRuns:
-    """:func:`expansion_error` on windows of one expansion, ``samples_per_period`` per linear period, with totals."""
+    """:func:`expansion_error` on windows of one expansion, ``samples_per_period`` per linear period, with totals;
+    the windows of one call run on ``executor`` when given (:func:`lindstedt._sweep.sweep_map`)."""
 
     def __init__(self, expansion: Expansion, omega0: float, samples_per_period: int, values: Mapping[Any, Any] | None,
-                 a1: float, rtol: float, atol: float) -> None:
-        self.expansion, self.omega0, self.samples_per_period = expansion, omega0, samples_per_period
-        self.options = {"values": values, "a1": a1, "rtol": rtol, "atol": atol}
+                 a1: float, rtol: float, atol: float, executor: Any = None, progress: Any = None) -> None:
+        self.run = {"expansion": expansion, "omega0": omega0, "samples_per_period": samples_per_period,
+                    "options": {"values": values, "a1": a1, "rtol": rtol, "atol": atol}}
+        self.executor, self.progress = executor, progress
         self.solves = self.samples = self.switches = self.evaluations = 0
 
-    def __call__(self, eps: float, t_end: float) -> ExpansionError:
-        samples = _default_samples(t_end, self.omega0, self.samples_per_period)
-        result = expansion_error(self.expansion, eps, t_end, samples, **self.options)
+    def _count(self, result: ExpansionError) -> None:
         self.solves += 1
         self.samples += result.n_samples
         self.switches += result.n_switches
         self.evaluations += result.n_evaluations
-        return result
+
+    def map(self, windows: Sequence[tuple[float, float]]) -> list[ExpansionError]:
+        """One :func:`expansion_error` per ``(ε, t_end)``, in order."""
+        results = sweep_map(partial(_error_task, **self.run), windows, executor=self.executor, progress=self.progress,
+                            description="expansion errors")
+        for result in results:
+            self._count(result)
+        return results
+
+    def first_exceedances(self, windows: Sequence[tuple[float, float, float]], period: float
+                          ) -> list[tuple[float | None, float, ExpansionError]]:
+        """Per ``(ε, threshold, t_max)``: (first time ρ > threshold or None, last window, last run)."""
+        outcomes = sweep_map(partial(_validity_task, period=period, **self.run), windows, executor=self.executor,
+                             progress=self.progress, description="validity times")
+        found = []
+        for time_found, span, runs in outcomes:
+            for result in runs:
+                self._count(result)
+            found.append((time_found, span, runs[-1]))
+        return found
 
     def totals(self) -> dict[str, int]:
         """The counters, as the ``n_*`` fields of the fit results."""
@@ -435,6 +483,8 @@ def fitted_convergence_order(
     a1: float = 0.0,
     rtol: float = DEFAULT_RTOL,
     atol: float = DEFAULT_ATOL,
+    executor: Any = None,
+    progress: Any = None,
 ) -> ConvergenceFit:
     """Fit the slope of ``log max|u_N − u|`` over ``[0, C/ε]`` against ``log ε``.
 
@@ -455,6 +505,9 @@ def fitted_convergence_order(
         Grid density per linear period.
     values, a1, rtol, atol
         As in :func:`expansion_error`.
+    executor, progress
+        Run the ε values on any ``concurrent.futures``-style executor (a process pool, a Dask cluster),
+        with a tqdm bar (``True``) or a callable ``progress(index, (ε, t_end), result)``.
 
     Returns
     -------
@@ -472,16 +525,11 @@ def fitted_convergence_order(
     eps_values = _as_epsilons(epsilons)
     t_end_of, rule_name = _t_end_function(t_end_rule, float(t_end_constant))
     numeric = _numeric_problem(expansion, values)
-    runs = _ErrorRuns(expansion, numeric.omega0, samples_per_period, values, a1, rtol, atol)
-    max_errors, t_ends = [], []
-    failures = []
-    for eps in eps_values:
-        t_end = t_end_of(float(eps))
-        t_ends.append(t_end)
-        result = runs(float(eps), t_end)
-        max_errors.append(result.max_error)
-        if not result.success:
-            failures.append(f"ε = {eps:g}: {result.message}")
+    runs = _ErrorRuns(expansion, numeric.omega0, samples_per_period, values, a1, rtol, atol, executor, progress)
+    t_ends = [t_end_of(float(eps)) for eps in eps_values]
+    results = runs.map([(float(eps), t_end) for eps, t_end in zip(eps_values, t_ends)])
+    max_errors = [result.max_error for result in results]
+    failures = [f"ε = {eps:g}: {result.message}" for eps, result in zip(eps_values, results) if not result.success]
     errors = np.array(max_errors)
     amplitude = max(abs(numeric.a0), 1e-300)
     floor = _ROUNDING_FLOOR * amplitude
@@ -595,6 +643,8 @@ def fitted_validity_exponent(
     values: Mapping[Any, Any] | None = None,
     rtol: float = DEFAULT_RTOL,
     atol: float = DEFAULT_ATOL,
+    executor: Any = None,
+    progress: Any = None,
 ) -> ValidityFit:
     """Fit p in ``T_ε ~ ε^p``, T_ε the first time ``ρ(t) > C ε^q``.
 
@@ -627,8 +677,9 @@ def fitted_validity_exponent(
     horizon : callable, optional
         ``eps -> t_max``, the longest window searched (the window starts at
         16 P0 and doubles).  Default ``400/ε``.
-    samples_per_period, values, rtol, atol
-        As in :func:`fitted_convergence_order`.
+    samples_per_period, values, rtol, atol, executor, progress
+        As in :func:`fitted_convergence_order` (the calibration runs and the searches of the ε values are
+        the tasks).
 
     Returns
     -------
@@ -653,7 +704,7 @@ def fitted_validity_exponent(
     horizon_of = horizon if horizon is not None else (lambda eps: 400.0 / eps)
     if calibration_factor is None:
         calibration_factor = 10.0 if grazing else 3.0
-    errors_on = _ErrorRuns(expansion, numeric.omega0, samples_per_period, values, a1_value, rtol, atol)
+    errors_on = _ErrorRuns(expansion, numeric.omega0, samples_per_period, values, a1_value, rtol, atol, executor, progress)
 
     failures: list[str] = []
     # the threshold
@@ -661,8 +712,7 @@ def fitted_validity_exponent(
         if tolerance_rule != "auto":
             raise ProblemError(f"tolerance_rule must be 'auto', a positive number C or a callable, got {tolerance_rule!r}")
         scaled = []
-        for eps in eps_values:
-            result = errors_on(float(eps), calibration_periods * period)
+        for eps, result in zip(eps_values, errors_on.map([(float(eps), calibration_periods * period) for eps in eps_values])):
             if not result.success:
                 failures.append(f"calibration at ε = {eps:g}: {result.message}")
             scaled.append(result.max_phase_error / eps**power)
@@ -677,31 +727,18 @@ def fitted_validity_exponent(
         constant = _as_positive(tolerance_rule, "the threshold constant C")
         threshold_of = lambda eps: constant * eps**power  # noqa: E731
 
-    validity_times, thresholds, horizons = [], [], []
-    for eps in eps_values:
-        threshold = threshold_of(float(eps))
-        thresholds.append(threshold)
-        t_max = float(horizon_of(float(eps)))
-        window = min(16 * period, t_max)
-        found = None
-        reference_failed = False
-        while True:
-            result = errors_on(float(eps), window)
-            if not result.success:
-                failures.append(f"ε = {eps:g}: {result.message}")
-                reference_failed = True
-                break
-            found = _first_exceedance(result.times, result.phase_error, threshold)
-            if found is not None or window >= t_max:
-                break
-            window = min(2 * window, t_max)
+    thresholds = [threshold_of(float(eps)) for eps in eps_values]
+    searches = errors_on.first_exceedances(
+        [(float(eps), threshold, float(horizon_of(float(eps)))) for eps, threshold in zip(eps_values, thresholds)], period
+    )
+    validity_times, horizons = [], []
+    for eps, threshold, (found, window, last) in zip(eps_values, thresholds, searches):
         horizons.append(window)
-        if found is None:
-            validity_times.append(math.nan)
-            if not reference_failed:
-                failures.append(f"ε = {eps:g}: ρ stayed below {threshold:.3e} up to t = {window:g}")
-        else:
-            validity_times.append(found)
+        if not last.success:
+            failures.append(f"ε = {eps:g}: {last.message}")
+        elif found is None:
+            failures.append(f"ε = {eps:g}: ρ stayed below {threshold:.3e} up to t = {window:g}")
+        validity_times.append(math.nan if found is None else found)
     times = np.array(validity_times)
     fit = _fit_or_nan(eps_values, times)
     success = not failures and math.isfinite(fit.slope)

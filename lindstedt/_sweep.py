@@ -1,0 +1,86 @@
+"""One loop for every sweep: independent tasks over a list of values, serial or on any executor.
+
+``sweep_map(task, values, executor=..., progress=...)`` returns ``[task(v) for v in values]`` in input
+order.  ``executor`` is anything with ``concurrent.futures``' ``submit`` (a thread or process pool, or a
+Dask cluster's ``distributed.Client(...).get_executor()``); ``progress`` is ``True`` for a tqdm bar (a
+warning names ``pip install tqdm`` when it is missing) or a callable ``progress(index, value, result)``
+called as each task finishes (completion order with an executor).  Used by :func:`lindstedt.nnm_sweep`,
+:func:`lindstedt.validate.backbone`, the fitted orders of :mod:`lindstedt.validate` and the
+forced-response families.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any, Callable, Iterable, Sequence, TypeVar
+
+__all__ = ["MPMATH_LOCK", "sweep_map"]
+
+#: mpmath's working precision is one process-wide setting (``mp.dps``), so two threads inside
+#: ``mpmath.workdps`` blocks change each other's precision.  Tasks that compute with mpmath hold this lock:
+#: on a thread pool (or a Dask cluster of threads) they run one at a time, correctly; process pools and
+#: Dask clusters of processes run them in parallel.
+MPMATH_LOCK = threading.RLock()
+
+Result = TypeVar("Result")
+
+
+def _reporter(progress: Any, total: int, description: str) -> tuple[Callable[[int, Any, Any], Any], Callable[[], Any]]:
+    """(report, close): nothing, the user's callable, or a tqdm bar."""
+    if progress is None or progress is False:
+        return (lambda *_: None), (lambda: None)
+    if callable(progress):
+        return progress, (lambda: None)
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:
+        import warnings
+
+        warnings.warn("progress=True needs tqdm: pip install tqdm (no progress bar shown)", stacklevel=4)
+        return (lambda *_: None), (lambda: None)
+    bar = tqdm(total=total, desc=description, unit="point")
+    return (lambda *_: bar.update(1)), bar.close
+
+
+def sweep_map(
+    task: Callable[[Any], Result],
+    values: Iterable[Any],
+    *,
+    executor: Any = None,
+    progress: bool | Callable[[int, Any, Any], Any] | None = None,
+    description: str = "sweep",
+) -> list[Result]:
+    """``[task(v) for v in values]``, on ``executor`` when given, reporting ``progress``.
+
+    ``task`` must be picklable for a process pool or a Dask cluster (a module-level function or a
+    ``functools.partial`` of one).  A task that computes with mpmath holds :data:`MPMATH_LOCK`, so threads
+    give correct results but no speed-up for it: use processes.
+
+    Examples
+    --------
+    >>> from concurrent.futures import ThreadPoolExecutor
+    >>> seen = []
+    >>> with ThreadPoolExecutor(2) as pool:
+    ...     squares = sweep_map(abs, [-3, 2, -1], executor=pool, progress=lambda i, v, r: seen.append(i))
+    >>> squares, sorted(seen)
+    ([3, 2, 1], [0, 1, 2])
+    """
+    values = list(values) if not isinstance(values, Sequence) else values
+    report, close = _reporter(progress, len(values), description)
+    results: list[Any] = [None] * len(values)
+    try:
+        if executor is None:
+            for index, value in enumerate(values):
+                results[index] = task(value)
+                report(index, value, results[index])
+        else:
+            from concurrent.futures import as_completed
+
+            futures = {executor.submit(task, value): index for index, value in enumerate(values)}
+            for future in as_completed(futures):
+                index = futures[future]
+                results[index] = future.result()
+                report(index, values[index], results[index])
+    finally:
+        close()
+    return results
