@@ -1,11 +1,72 @@
-"""Sphinx configuration: the API reference comes from the numpy-style docstrings (autodoc + napoleon)."""
+"""Sphinx configuration.
+
+* The API reference comes from the numpy-style docstrings (autodoc + napoleon).
+* Figures on the pages are drawn by :mod:`lindstedt.plot` at build time (matplotlib's ``.. plot::`` directive).
+* The gallery is the notebooks of ``../notebooks``, executed at every build (myst-nb): they are stored without
+  outputs, so what the site shows is what the code computes now, and a notebook whose checks fail breaks the
+  build.  Sphinx only reads documents inside ``docs/``, so the notebooks are copied to ``docs/notebooks/``
+  (generated, git-ignored by ``docs/.gitignore``) when a build starts (``config-inited``); the copies are never
+  edited, and reading this file has no side effect.
+"""
+
+import os
+import pathlib
+import shutil
+
+DOCS = pathlib.Path(__file__).resolve().parent
+NOTEBOOKS = DOCS.parent / "notebooks"
+GALLERY = DOCS / "notebooks"  # generated copies of ../notebooks/*.ipynb
+
+
+def _prepare_gallery(app, config) -> None:
+    """Copy ../notebooks/*.ipynb to docs/notebooks/ (only what changed; stale copies go) before Sphinx reads."""
+    GALLERY.mkdir(exist_ok=True)
+    sources = {path.name: path for path in NOTEBOOKS.glob("*.ipynb")}
+    for stale in GALLERY.glob("*.ipynb"):
+        if stale.name not in sources:
+            stale.unlink()
+    for name, source in sources.items():
+        target = GALLERY / name
+        if not target.exists() or target.read_bytes() != source.read_bytes():
+            shutil.copyfile(source, target)
+    # the notebook kernels (children of this process) draw with Jupyter's inline backend, so that figures become
+    # image/png outputs whatever the environment says (MPLBACKEND=Agg would leave the gallery without figures);
+    # the plot directive selects Agg for itself
+    os.environ["MPLBACKEND"] = "module://matplotlib_inline.backend_inline"
+
+
+def setup(app):
+    app.connect("config-inited", _prepare_gallery)
+
 
 project = "lindstedt"
 author = "the lindstedt developers"
-extensions = ["sphinx.ext.autodoc", "sphinx.ext.napoleon", "sphinx.ext.mathjax", "sphinx.ext.viewcode"]
+extensions = [
+    "sphinx.ext.autodoc",
+    "sphinx.ext.napoleon",
+    "sphinx.ext.mathjax",
+    "sphinx.ext.viewcode",
+    "matplotlib.sphinxext.plot_directive",
+    "myst_nb",
+]
 autodoc_member_order = "bysource"
 autodoc_typehints = "none"
 napoleon_numpy_docstring = True
 napoleon_google_docstring = False
-exclude_patterns = ["_build"]
+exclude_patterns = ["_build", "jupyter_execute", "**.ipynb_checkpoints"]
 html_theme = "alabaster"
+
+# figures drawn by lindstedt.plot at build time (.. plot::)
+plot_include_source = True
+plot_html_show_source_link = False
+plot_html_show_formats = False
+plot_formats = [("png", 90)]
+plot_rcparams = {"figure.figsize": (7.0, 4.0)}
+
+# the gallery: notebooks executed at every build, a failing cell (or assertion) fails the build
+nb_execution_mode = "force"
+nb_execution_timeout = 120  # seconds per cell (tests/test_notebooks.py: CELL_TIMEOUT)
+nb_execution_raise_on_error = True
+nb_execution_show_tb = True
+nb_merge_streams = True
+myst_enable_extensions = ["dollarmath", "amsmath"]

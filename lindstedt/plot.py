@@ -12,7 +12,7 @@ None) and returns the Axes; the data drawn are those of the package's results an
   solution side by side (seed fig. 2);
 * :func:`convergence` — max error against ε on log-log axes with the fitted slope
   (:class:`lindstedt.validate.ConvergenceFit`);
-* :func:`error_over_time` — |u_N(t) − u(t)| against t for expansions of several orders (the exact flow as u);
+* :func:`error_over_time` — ``|u_N(t) − u(t)|`` against t for expansions of several orders (the exact flow as u);
 * :func:`branch` — an NNM branch (:class:`lindstedt.NNMBranch`): frequency against the continuation parameter,
   stable points solid, unstable dashed, jumps across internal-resonance tongues marked;
 * :func:`nnm_orbit` — one NNM (:class:`lindstedt.NNMResult`) over a period of the exact flow: the orbit in
@@ -208,7 +208,7 @@ def convergence(fits: Any, *, labels: Sequence[str] | None = None, ax: Any = Non
 
 def error_over_time(expansions: Any, epsilon: float, t: Sequence[float], *, values: dict[str, Any] | None = None,
                     ax: Any = None) -> Any:
-    """|u_N(t) − u(t)| against t (log scale) for one or several expansions of one problem, u the exact flow.
+    """``|u_N(t) − u(t)|`` against t (log scale) for one or several expansions of one problem, u the exact flow.
 
     The reference is :func:`lindstedt.validate.reference_solution` (closed-form arcs for piecewise-linear f,
     DOP853 otherwise), computed once; each expansion is labelled by its order.  Errors below 1e-16 are drawn at

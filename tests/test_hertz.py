@@ -135,3 +135,14 @@ def test_the_stretched_arc_exports_itself_and_evaluates_like_the_expansion():
         expansion.displacement_expr()
     with pytest.raises(lindstedt.UnsupportedNonlinearityError, match="spectrum"):
         expansion.waveforms[1].cosine_coefficient(1)
+
+
+@pytest.mark.parametrize("law, regime", [
+    ("Max(0, u - 1/5)**(3/2)", "contact"),       # the orbit (|u| ≤ 1) enters the Hertz contact u > 1/5
+    ("Max(0, u - 1/5)*exp(u)", "contact"),       # an analytic law on the contact arc
+    ("Max(0, u - 2)**(3/2)", "no contact"),      # the contact at u = 2 is never reached
+])
+def test_the_regime_of_a_stretched_arc_law_says_whether_the_orbit_is_in_contact(law, regime):
+    expansion = lindstedt.expand(law, order=1, a0=1, omega0=1, precision=20)
+    assert expansion.regime == regime
+    assert (expansion.omega[1] != 0) == (regime == "contact")  # ω1 = (1/π)∫ f(cos s) cos s ds vanishes only without contact

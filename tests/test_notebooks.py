@@ -2,8 +2,11 @@
 
 Each notebook reproduces a figure of the seed with lindstedt and ends with a
 cell of assertions against independent references, so executing it is a test.
-They run in a fresh ``python3`` kernel (nbclient) with ``MPLBACKEND=Agg``, from
-the ``notebooks/`` directory, each within its own time budget.
+They run in a fresh ``python3`` kernel (nbclient) with matplotlib's inline
+backend (headless, as in Jupyter), from the ``notebooks/`` directory, each
+within its own time budget.  The executed notebooks must show what a reader
+sees in Jupyter: the figures drawn by ``lindstedt.plot`` (``image/png``
+outputs) and the results' rich displays (``_repr_latex_`` / ``_repr_html_``).
 
 Needs the ``notebooks`` extra (``pip install -e ".[dev,notebooks]"``).  Without
 it the execution tests are skipped locally, but fail under CI (``CI`` set), so
@@ -21,7 +24,7 @@ import pytest
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
 
-#: every notebook with its wall-clock budget in seconds (measured: 4–8 s each on 2 cores, kernel start included)
+#: every notebook with its wall-clock budget in seconds (measured: 3–12 s each on 2 cores, kernel start included)
 BUDGETS = {
     "fig2_spectrum_u_plus.ipynb": 60,
     "fig3_lp_nnm_5dof.ipynb": 60,
@@ -33,6 +36,49 @@ BUDGETS = {
 }
 #: nbclient's limit for one cell
 CELL_TIMEOUT = 120
+#: the matplotlib backend of the kernel: Jupyter's inline backend, so that figures become image/png outputs
+INLINE_BACKEND = "module://matplotlib_inline.backend_inline"
+
+#: the ``lindstedt.plot`` functions each notebook draws its figures with (runtime_vs_error plots benchmark files,
+#: for which the plotting API has no figure)
+PLOT_FUNCTIONS = {
+    "backbone.ipynb": {"backbone", "branch"},
+    "fig2_spectrum_u_plus.ipynb": {"spectrum", "waveform"},
+    "fig3_lp_nnm_5dof.ipynb": {"waveform"},
+    "fig4_8_numerical_nnm.ipynb": {"nnm_orbit", "branch"},
+    "hertz_backbone.ipynb": {"backbone", "convergence", "waveform"},
+    "validity_time.ipynb": {"convergence"},
+    "runtime_vs_error.ipynb": set(),
+}
+#: the figures (image/png outputs) each executed notebook shows, at least
+FIGURES = {
+    "backbone.ipynb": 2,
+    "fig2_spectrum_u_plus.ipynb": 1,
+    "fig3_lp_nnm_5dof.ipynb": 2,
+    "fig4_8_numerical_nnm.ipynb": 3,
+    "hertz_backbone.ipynb": 2,
+    "validity_time.ipynb": 2,
+    "runtime_vs_error.ipynb": 3,
+}
+#: rich displays of results (the last expression of a cell): (mime type, fragments that one such output contains)
+DISPLAYS = {
+    "backbone.ipynb": [
+        # Expansion._repr_latex_: the equation and the exact ω_1 of the gap b = 1/2
+        ("text/latex", [r"\ddot u + u + \varepsilon \max\left(0, u - \frac{1}{2}\right) = 0",
+                        r"\omega_{1} &= \frac{- 3 \sqrt{3} + 4 \pi}{24 \pi}"]),
+        ("text/latex", [r"\lambda_{1} &=", r"a_{2} &="]),                              # NNMExpansion
+        ("text/html", ['<table class="lindstedt">', "<b>NNMBranch: "]),
+        ("text/html", ['<table class="lindstedt">', "<b>NNMResult: mode 1, converged"]),
+    ],
+    "fig2_spectrum_u_plus.ipynb": [
+        ("text/latex", [r"\ddot u + u + \varepsilon \max\left(0, u\right) = 0", r"\omega_{1} &= \frac{1}{4}"]),
+    ],
+    "fig3_lp_nnm_5dof.ipynb": [("text/latex", [r"\lambda_{1} &=", r"\omega(\varepsilon) &="])],
+    "hertz_backbone.ipynb": [
+        ("text/latex", ["Stretched contact arc", r"|u - b|^{3/2}"]),
+        ("text/html", ['<table class="lindstedt">', "<b>StretchedArcSeries"]),
+    ],
+}
 
 
 def _load(name: str) -> dict:
@@ -55,6 +101,14 @@ def test_saved_without_outputs(name):
         assert cell.get("execution_count") is None, f"{name}: code cell {index} has an execution count; strip it"
         assert "execution" not in cell.get("metadata", {}), f"{name}: code cell {index} has execution metadata"
     assert notebook["metadata"]["kernelspec"]["name"] == "python3"
+
+
+@pytest.mark.parametrize("name", sorted(BUDGETS))
+def test_figures_come_from_the_plotting_api(name):
+    sources = "".join("".join(cell["source"]) for cell in _code_cells(_load(name)))
+    for function in sorted(PLOT_FUNCTIONS[name]):
+        assert f"lindstedt.plot.{function}(" in sources, f"{name}: draw with lindstedt.plot.{function}"
+    assert set(PLOT_FUNCTIONS) == set(BUDGETS) == set(FIGURES)
 
 
 @pytest.mark.parametrize("name", sorted(BUDGETS))
@@ -81,7 +135,7 @@ def _client_modules():
 @pytest.mark.parametrize("name", sorted(BUDGETS))
 def test_notebook_executes(name, monkeypatch):
     nbclient, nbformat = _client_modules()
-    monkeypatch.setenv("MPLBACKEND", "Agg")
+    monkeypatch.setenv("MPLBACKEND", INLINE_BACKEND)
     notebook = nbformat.read(NOTEBOOKS / name, as_version=4)
     client = nbclient.NotebookClient(
         notebook,
@@ -96,7 +150,23 @@ def test_notebook_executes(name, monkeypatch):
         pytest.fail(f"{name} failed:\n{error}")
     elapsed = time.perf_counter() - started
     assert elapsed < BUDGETS[name], f"{name} took {elapsed:.1f} s (budget {BUDGETS[name]} s)"
-    printed = "".join(
-        output.get("text", "") for cell in notebook.cells if cell.cell_type == "code" for output in cell.outputs
-    )
+    outputs = [output for cell in notebook.cells if cell.cell_type == "code" for output in cell.outputs]
+    # an exception raised while a figure is drawn (after the cell's code ran) does not stop nbclient
+    errors = [f"{output.get('ename')}: {output.get('evalue')}" for output in outputs if output.get("output_type") == "error"]
+    assert not errors, f"{name}: error outputs {errors}"
+    printed = "".join(output.get("text", "") for output in outputs)
     assert "all checks passed" in printed, f"{name}: the final checks did not report success"
+    rich = [output.get("data", {}) for output in outputs]
+    figures = sum("image/png" in data for data in rich)
+    assert figures >= FIGURES[name], f"{name}: {figures} figures (image/png outputs), expected {FIGURES[name]}"
+    for mime, fragments in DISPLAYS.get(name, []):
+        shown = [data[mime] for data in rich if mime in data]
+        assert any(all(fragment in text for fragment in fragments) for text in shown), (
+            f"{name}: no {mime} output shows {fragments}; got {[text[:200] for text in shown]}")
+    if name == "backbone.ipynb":
+        # the LaTeX Jupyter shows is the expansion's own, display math around its to_latex() equations
+        import lindstedt
+
+        expected = lindstedt.expand("Max(0, u - 1/2)", order=2, a0=1, omega0=1)._repr_latex_()
+        assert expected.startswith("$$") and r"\omega" in expected
+        assert expected in [data["text/latex"] for data in rich if "text/latex" in data]

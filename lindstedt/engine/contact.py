@@ -443,7 +443,7 @@ def _assemble(
     )
     if grazing:
         regime = "grazing"
-    elif all(not value for law in piece_laws for value in law):
+    elif all(not value for law in piece_laws for value in law) and not any(arcs):  # a stretched (Hertz) arc is contact
         regime = "no contact"
     else:
         regime = "contact"
