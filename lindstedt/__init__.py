@@ -47,6 +47,9 @@ _LAZY = {
     "methods.strained_coordinates": ("StrainedCoordinatesNNM", "nnm"),
     "numerics": ("NNMBranch", "NNMResult", "continue_nnm", "nnm_point", "nnm_sweep", "seed_example_system"),
     "problems.oscillator": ("Oscillator",),
+    "problems.forced": ("ForcedOscillator", "ForcedSystem"),
+    "methods.multiple_scales": ("MultipleScales", "frequency_response_curve"),
+    "results.frequency_response": ("FrequencyResponseCurve",),
     "problems.system": ("Modes", "UnilateralSystem"),
     "validate": (
         "Spectrum",

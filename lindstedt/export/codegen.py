@@ -199,8 +199,10 @@ def generate_code(expansion: Any, quantity: str = "frequency", language: str = "
 
     Parameters
     ----------
-    expansion : Expansion
+    expansion : Expansion, NNMExpansion or FrequencyResponseCurve
     quantity : {"frequency", "displacement", "omega<k>"}
+        For a FrequencyResponseCurve: one of its :meth:`~lindstedt.FrequencyResponseCurve.code_form` quantities
+        (``"detuning_upper"``, ``"backbone"``, ``"relation"``, …).
     language : {"numpy", "c", "octave", "julia", "fortran", "rust", "jax"}
         Any other value raises :class:`CodeGenerationError` (also a ``ValueError``) naming these.
         :meth:`GeneratedCode.compile` runs NumPy, JAX and C code; the others are for their own toolchains.
@@ -220,12 +222,20 @@ def generate_code(expansion: Any, quantity: str = "frequency", language: str = "
     ('epsilon', 'a0', 'omega0')
     """
     from ..results.expansion import EPSILON, TIME, Expansion
+    from ..results.frequency_response import FrequencyResponseCurve
     from ..results.nnm import NNMExpansion
 
     if isinstance(expansion, NNMExpansion):  # numeric coefficients, no free parameters
         return _nnm_code(expansion, quantity, language)
+    if isinstance(expansion, FrequencyResponseCurve):  # closed forms in the amplitude A
+        arguments, vector, expression = expansion.code_form(quantity)
+        _check_language(language)
+        return _generated(language, quantity, arguments, vector, expression.evalf(25), _UNANALYSED)
     if not isinstance(expansion, Expansion):
-        raise ProblemError(f"generate_code takes an Expansion (lindstedt.expand) or an NNMExpansion (lindstedt.nnm), got {type(expansion).__name__}")
+        raise ProblemError(
+            "generate_code takes an Expansion (lindstedt.expand), an NNMExpansion (lindstedt.nnm) or a "
+            f"FrequencyResponseCurve (lindstedt.frequency_response_curve), got {type(expansion).__name__}"
+        )
     coefficient = _coefficient_index(quantity)
     if quantity not in _QUANTITIES and coefficient is None:
         raise ProblemError(f"quantity must be one of {_QUANTITIES} or 'omega<k>' (e.g. 'omega2')")

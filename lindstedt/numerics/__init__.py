@@ -58,6 +58,8 @@ Examples
 """
 
 from .flow import ExactFlow, FlowMapResult, FlowResult, SwitchEvent
+from ._period_map import PeriodMap, PeriodMapValue
+from .forced_flow import ForcedFlow
 from .smooth import smooth_flow
 from .continuation import continue_nnm, nnm_sweep
 from .examples import seed_example_system
@@ -82,4 +84,7 @@ __all__ = [
     "nnm_energy",
     "seed_example_system",
     "to_dataframe",
+    "ForcedFlow",
+    "PeriodMap",
+    "PeriodMapValue",
 ]

@@ -69,15 +69,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Callable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 import numpy as np
 
 from .._errors import ProblemError
 from ..export.display import format_number, format_vector, html_table, labelled_repr
-from ..export.json import JsonExport
+from ..export.json import JsonExport, exported_fields, to_jsonable
 from ..problems.system import UnilateralSystem
-from .switching import _Bracket, _Counters, _first_exit, _SearchFailure
+from .switching import _Bracket, _Counters, _earliest_switch, _first_exit_trig, _SearchFailure
+
+if TYPE_CHECKING:
+    from ..problems.forced import ForcedOscillator, ForcedSystem
 
 __all__ = ["ExactFlow", "FlowResult", "FlowMapResult", "SwitchEvent"]
 
@@ -124,7 +127,7 @@ class SwitchEvent(JsonExport):
 
 @dataclass(frozen=True)
 class FlowResult(JsonExport):
-    """Trajectory returned by :meth:`ExactFlow.solve` and :func:`smooth_flow`.
+    """Trajectory returned by :meth:`ExactFlow.solve`, :func:`smooth_flow` and :meth:`ForcedFlow.solve`.
 
     Attributes
     ----------
@@ -133,7 +136,7 @@ class FlowResult(JsonExport):
     message : str
         What happened (why it stopped, when it failed).
     method : str
-        ``"exact"`` (closed-form arcs) or ``"DOP853"``.
+        ``"exact"`` (closed-form arcs), ``"exact-forced"`` (:class:`ForcedFlow`) or ``"DOP853"``.
     t_final : float
         Last time reached (``t_end`` on success).
     position, velocity : numpy.ndarray, shape (N,)
@@ -156,12 +159,15 @@ class FlowResult(JsonExport):
     contact_states : tuple of tuple of int
         Distinct contact states visited, in order of first visit, each given by
         its engaged springs.
-    system : UnilateralSystem or None
-        The system flowed (:meth:`ExactFlow.solve`; None for :func:`smooth_flow`,
-        whose right-hand side is a function).  Exported exactly, as
-        :meth:`UnilateralSystem.to_json_dict`.
+    system : UnilateralSystem, ForcedSystem, ForcedOscillator or None
+        The problem flowed: the :class:`UnilateralSystem` of :meth:`ExactFlow.solve`,
+        the forced problem of :meth:`ForcedFlow.solve`; None for :func:`smooth_flow`,
+        whose right-hand side is a function.  Exported exactly, as
+        :meth:`UnilateralSystem.to_json_dict` or :meth:`ForcedSystem.to_json_dict`;
+        a :class:`ForcedOscillator` as its equation (``description``) and its ``f``,
+        ``params``, ``omega0``, ``zeta`` and ``forcing`` as strings (the arguments that rebuild it).
     epsilon : float or None
-        ε of the flow (:meth:`ExactFlow.solve`).
+        ε of the flow (:meth:`ExactFlow.solve`, :meth:`ForcedFlow.solve`).
 
     JSON schema ``lindstedt.flow/1`` (:meth:`to_json`; the dense output is not exported).
     """
@@ -182,8 +188,25 @@ class FlowResult(JsonExport):
     n_decompositions: int
     contact_states: tuple[tuple[int, ...], ...]
     _evaluator: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] = field(repr=False, compare=False)
-    system: UnilateralSystem | None = field(default=None, repr=False, compare=False)
+    system: UnilateralSystem | ForcedSystem | ForcedOscillator | None = field(default=None, repr=False, compare=False)
     epsilon: float | None = field(default=None, repr=False, compare=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dictionary (see :class:`~lindstedt.export.json.JsonExport`); a forced problem as in ``system`` above.
+
+        Examples
+        --------
+        >>> from lindstedt.numerics.forced_flow import ForcedFlow
+        >>> from lindstedt.problems.forced import ForcedOscillator
+        >>> run = ForcedFlow(ForcedOscillator("Max(0, u - 1/5)", omega0=1, zeta="1/20"), 0.5).solve([0.0, 0.0], 5.0, 1.2)
+        >>> run.to_dict()["system"]["zeta"]
+        '1/20'
+        """
+        data: dict[str, Any] = {"schema": type(self).SCHEMA}
+        for item in exported_fields(self):
+            value = getattr(self, item.name)
+            data[item.name] = _problem_json(value) if item.name == "system" else to_jsonable(value)
+        return data
 
     @property
     def n_states_visited(self) -> int:
@@ -252,6 +275,26 @@ class FlowResult(JsonExport):
     def _repr_html_(self) -> str:
         """Jupyter's rendering: a two-column table of :meth:`__repr__`'s fields."""
         return html_table(f"FlowResult: {'success' if self.success else 'FAILED'}", self._display_rows(quoted=False))
+
+
+def _problem_json(problem: Any) -> Any:
+    """The JSON form of the problem a flow ran on (forced problems included)."""
+    from ..problems.forced import ForcedOscillator, ForcedSystem  # here: import lindstedt stays light
+
+    if isinstance(problem, ForcedSystem):
+        return problem.to_json_dict()
+    if isinstance(problem, ForcedOscillator):
+        import sympy
+
+        return {
+            "description": problem.describe(),
+            "f": sympy.sstr(problem.f),
+            "params": {str(name): None if value == name else sympy.sstr(value) for name, value in problem.params},
+            "omega0": sympy.sstr(problem.omega0),
+            "zeta": sympy.sstr(problem.zeta),
+            "forcing": sympy.sstr(problem.forcing),
+        }
+    return to_jsonable(problem)
 
 
 @dataclass(frozen=True)
@@ -655,21 +698,13 @@ class ExactFlow:
         brackets: list[tuple[_Bracket, int]] = []
         horizon = tau_max
         for i in range(len(mode.active)):
-            bracket = _first_exit(
+            bracket = _first_exit_trig(
                 float(offsets[i]), cos_coefficients[i], sin_coefficients[i], mode.omega, float(bands[i]), horizon, counters
             )
             if bracket is not None:
                 brackets.append((bracket, i))
                 horizon = min(horizon, bracket.high)  # a later root cannot be the first
-        # polish only the brackets that can hold the earliest root
-        best_tau, best_spring = math.inf, None
-        for bracket, i in sorted(brackets, key=lambda item: (item[0].low, item[1])):
-            if bracket.low > best_tau:
-                break
-            tau = bracket.polish(counters)
-            if tau < best_tau:
-                best_tau, best_spring = tau, i
-        return (best_tau, best_spring) if best_spring is not None else (None, None)
+        return _earliest_switch(brackets, counters)
 
     def _run(self, x0: Any, v0: Any, t_end: Any, *, dense: bool, sensitivity: bool) -> dict[str, Any]:
         system = self.system

@@ -1,11 +1,16 @@
-"""Certified search for the first switch of a contact: the first exit of a trigonometric sum from one side of 0.
+"""Certified search for the first switch of a contact: the first exit of a gap function from one side of 0.
+
+:func:`_first_exit` works on any gap function h given by evaluators of (h, h', h'')
+and of h, with the bounds ``|h″| ≤ G2`` and ``|h‴| ≤ G3`` on the search interval and an
+envelope ``h ≥ c − R``.  It advances only by steps that a Taylor minorant proves
+root-free (see the docstring of :mod:`lindstedt.numerics.flow`), so no excursion deeper
+than the rounding band can be stepped over, then polishes the root with Brent's method.
 
 Inside an arc of :class:`~lindstedt.numerics.ExactFlow` each gap function is
-``g(t) = c + Σ_k α_k cos ω_k t + β_k sin ω_k t`` with ``|g″| ≤ G2 = Σ ω_k² R_k`` and
-``|g‴| ≤ G3 = Σ ω_k³ R_k``.  :func:`_first_exit` advances only by steps that a Taylor
-minorant proves root-free (see the docstring of :mod:`lindstedt.numerics.flow`), so no
-excursion deeper than the rounding band can be stepped over, then polishes the root
-with Brent's method.
+``g(t) = c + Σ_k α_k cos ω_k t + β_k sin ω_k t`` with ``R = Σ R_k``, ``G2 = Σ ω_k² R_k``
+and ``G3 = Σ ω_k³ R_k`` (``R_k = hypot(α_k, β_k)``): :func:`_first_exit_trig` builds
+those evaluators and bounds.  :class:`~lindstedt.numerics.forced_flow.ForcedFlow` gives
+sums of damped exponentials ``c + Re Σ_k γ_k e^{λ_k τ}`` and their bounds.
 """
 
 from __future__ import annotations
@@ -165,14 +170,21 @@ def _leave_surface(value: float, slope: float, curvature: float, g2: float, g3: 
 
 def _first_exit(
     offset: float,
-    cos_coefficients: np.ndarray,
-    sin_coefficients: np.ndarray,
-    omega: np.ndarray,
+    amplitude: float,
+    derivatives: Callable[[float], tuple[float, float, float]],
+    value: Callable[[float], float],
+    g2: float,
+    g3: float,
+    slow_step: float,
     band: float,
     tau_max: float,
-    counters: _Counters,
 ) -> _Bracket | None:
-    """Bracket the first switching time of h(τ) = offset + Σ a_k cos ω_k τ + b_k sin ω_k τ.
+    """Bracket the first switching time of any h with |h''| ≤ g2 and |h'''| ≤ g3 on [0, tau_max].
+
+    ``derivatives(τ)`` returns (h, h', h'') and ``value(τ)`` returns h (the
+    function Brent's method polishes); ``h ≥ offset − amplitude`` on [0, tau_max]
+    (the envelope); a root-free step shorter than ``slow_step`` (a tenth of the
+    fastest time scale of h) is lengthened by the cubic minorant.
 
     The switching time is the zero of h that starts the first excursion of h
     below −band in (0, tau_max].  Returns None when h > −band on the whole of
@@ -180,17 +192,15 @@ def _first_exit(
     docstring, so no excursion deeper than band is missed.  Requires h(0) > −band.
     When h(0) ≤ band (the arc starts on the switching surface) the zero at
     τ = 0 is the switch that started the arc and is excluded (see
-    :func:`_leave_surface`).
+    :func:`_leave_surface`).  :func:`_first_exit_trig` supplies the evaluators and
+    bounds of a trigonometric sum (:class:`~lindstedt.numerics.ExactFlow`);
+    :class:`~lindstedt.numerics.forced_flow.ForcedFlow` those of sums of damped exponentials.
     """
     band = max(band, _TINY)
-    amplitudes = np.hypot(cos_coefficients, sin_coefficients)
-    if offset - float(amplitudes.sum()) > -band:  # envelope: never reaches −band
+    if offset - amplitude > -band:  # envelope: never reaches −band
         return None
-    omega2 = omega * omega
-    g2 = max(float(omega2 @ amplitudes) * (1.0 + 1e-12), _TINY)
-    g3 = max(float((omega2 * omega) @ amplitudes) * (1.0 + 1e-12), _TINY)
-    slow_step = 0.1 / float(omega.max())
-    derivatives, value = _trig_sum(offset, cos_coefficients, sin_coefficients, omega, counters)
+    g2 = max(g2 * (1.0 + 1e-12), _TINY)
+    g3 = max(g3 * (1.0 + 1e-12), _TINY)
 
     tau = 0.0
     h, h1, h2 = derivatives(tau)
@@ -249,4 +259,43 @@ def _first_exit(
         "(a gap function stalls at the rounding band)"
     )
 
+def _first_exit_trig(
+    offset: float,
+    cos_coefficients: np.ndarray,
+    sin_coefficients: np.ndarray,
+    omega: np.ndarray,
+    band: float,
+    tau_max: float,
+    counters: _Counters,
+) -> _Bracket | None:
+    """:func:`_first_exit` for h(τ) = offset + Σ a_k cos ω_k τ + b_k sin ω_k τ.
 
+    With R_k = hypot(a_k, b_k): the envelope Σ R_k and the bounds
+    |h''| ≤ Σ ω_k² R_k, |h'''| ≤ Σ ω_k³ R_k (module docstring).
+    """
+    amplitudes = np.hypot(cos_coefficients, sin_coefficients)
+    amplitude = float(amplitudes.sum())
+    if offset - amplitude > -max(band, _TINY):  # envelope: decided before any evaluator is built
+        return None
+    omega2 = omega * omega
+    derivatives, value = _trig_sum(offset, cos_coefficients, sin_coefficients, omega, counters)
+    return _first_exit(
+        offset, amplitude, derivatives, value, float(omega2 @ amplitudes), float((omega2 * omega) @ amplitudes),
+        0.1 / float(omega.max()), band, tau_max,
+    )
+
+
+def _earliest_switch(brackets: list[tuple[_Bracket, int]], counters: _Counters) -> tuple[float | None, int | None]:
+    """The earliest switching time among the brackets of the surfaces (bracket, index) and its index, or (None, None).
+
+    Only the brackets that can hold the earliest root are polished (in order of
+    their low ends; ties go to the lower index).
+    """
+    best_tau, best = math.inf, None
+    for bracket, i in sorted(brackets, key=lambda item: (item[0].low, item[1])):
+        if bracket.low > best_tau:
+            break
+        tau = bracket.polish(counters)
+        if tau < best_tau:
+            best_tau, best = tau, i
+    return (best_tau, best) if best is not None else (None, None)
