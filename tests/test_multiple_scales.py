@@ -321,7 +321,7 @@ def test_exports_latex_json_code():
     assert r"\begin{align*}" in latex and r"\sigma_{+}(A)" in latex and r"\operatorname{acos}" in latex
     assert curve._repr_latex_().startswith("$$\\begin{aligned}")
     data = json.loads(curve.to_json())
-    assert data["schema"] == "lindstedt.frequency-response/1"
+    assert data["schema"] == "lindstedt.frequency-response-curve/1"
     assert data["problem"]["f"] == "Max(0, u - 1/5)" and data["order"] == 1
     assert sympy.sympify(data["peak_amplitude"]) == 25 * sympy.Symbol("epsilon")
     code = curve.generate_code("detuning_upper", "numpy")

@@ -31,6 +31,18 @@ Nonlinear normal modes by shooting
     energy that parametrises them and :func:`seed_example_system` the seed's
     N-dof example.
 
+Forced and damped responses
+    ``u'' + 2ζω0 u' + ω0² u + ε f(u) = ε F cos Ωt`` and ``M X'' + C X' + K X + ε W (A X − b)_+ = ε P cos Ωt``
+    (:class:`lindstedt.ForcedOscillator`, :class:`lindstedt.ForcedSystem`): the exact event-driven
+    :class:`ForcedFlow` (piecewise-linear laws) and the DOP853 :class:`SmoothForcedFlow` (any law) share the
+    :class:`PeriodMap` interface (the period map Π with its monodromy and its derivatives in Ω and in the load);
+    :func:`forced_flow` picks the exact one where it applies.  :func:`forced_periodic_orbit` shoots one
+    periodic response (:class:`ForcedOrbit`: amplitudes, first harmonics, Floquet multipliers);
+    :func:`frequency_response` follows a branch in Ω or in the load by pseudo-arclength continuation through
+    folds and locates folds, period doublings and Neimark–Sacker points (:class:`FrequencyResponse`,
+    :class:`Bifurcation`); :func:`switch_period_doubling` continues the period-2 branch;
+    :func:`frequency_response_sweep` runs families on any executor.
+
 The systems themselves are :class:`lindstedt.UnilateralSystem`.
 
 Layout (the pipeline, in order)
@@ -60,6 +72,15 @@ Examples
 from .flow import ExactFlow, FlowMapResult, FlowResult, SwitchEvent
 from ._period_map import PeriodMap, PeriodMapValue
 from .forced_flow import ForcedFlow
+from .forced_smooth import SmoothForcedFlow
+from .forced_results import Bifurcation, ForcedOrbit, FrequencyResponse
+from .forced_response import (
+    forced_flow,
+    forced_periodic_orbit,
+    frequency_response,
+    frequency_response_sweep,
+    switch_period_doubling,
+)
 from .smooth import smooth_flow
 from .continuation import continue_nnm, nnm_sweep
 from .examples import seed_example_system
@@ -85,6 +106,15 @@ __all__ = [
     "seed_example_system",
     "to_dataframe",
     "ForcedFlow",
+    "SmoothForcedFlow",
     "PeriodMap",
     "PeriodMapValue",
+    "forced_flow",
+    "forced_periodic_orbit",
+    "frequency_response",
+    "frequency_response_sweep",
+    "switch_period_doubling",
+    "ForcedOrbit",
+    "FrequencyResponse",
+    "Bifurcation",
 ]

@@ -150,7 +150,7 @@ class FrequencyResponseCurve(JsonExport):
     1.0375
     """
 
-    SCHEMA: ClassVar[str] = "lindstedt.frequency-response/1"
+    SCHEMA: ClassVar[str] = "lindstedt.frequency-response-curve/1"
 
     problem: ForcedOscillator
     order: int

@@ -1,0 +1,444 @@
+"""The period map of a forced, damped oscillator by DOP853 and its variational equations, for any law.
+
+One degree of freedom (:class:`~lindstedt.problems.forced.ForcedOscillator`)::
+
+    u'' + 2 ζ ω0 u' + ω0² u + ε f(u) = ε s F cos(Ω t)
+
+with any f the package parses (smooth such as ``u**3``, or non-smooth such as ``Max(0, u - b)``,
+``Heaviside(u)``, ``Max(0, u)**(3/2)``), and N degrees of freedom
+(:class:`~lindstedt.problems.forced.ForcedSystem`)::
+
+    M X'' + C X' + K X + ε W (A X − b)_+ = ε s P cos(Ω t).
+
+:class:`SmoothForcedFlow` implements :class:`~lindstedt.numerics._period_map.PeriodMap`: it integrates
+``z = (X, X')`` together with the variational equations ``Y' = J(t, z) Y + ∂F/∂p`` for the
+2N + 2 columns ``∂z/∂z0`` (the monodromy), ``∂z/∂Ω`` and ``∂z/∂s`` with
+``scipy.integrate.solve_ivp(method="DOP853")``; ``∂Π/∂Ω`` adds the moving end ``kT = 2πk/Ω``
+(``F(kT) · (−kT/Ω)``).  A non-smooth law is integrated piecewise: between two breakpoints
+(``u = b`` of f, a gap ``A_i X − b_i = 0`` of a spring) the vector field is the analytic piece
+of that interval, a directional terminal event stops the integration at the crossing and the next
+piece starts there, so no step samples the kink.  Where f jumps (``Heaviside``, ``sign``) the
+sensitivities cross the switch through the saltation matrix ``S = I + Δ nᵀ/(nᵀ F⁻)``.
+f and f' come from the parsed sympy expression (``problem.nonlinearity``) by ``sympy.lambdify``.
+
+Examples
+--------
+>>> from lindstedt.problems.forced import ForcedOscillator
+>>> flow = SmoothForcedFlow(ForcedOscillator("u", omega0=1, zeta="1/20", forcing=1), 0.5)
+>>> value = flow.period_map([0.0, 0.0], 1.2)
+>>> value.state.shape, value.d_state.shape, value.d_frequency.shape
+((2,), (2, 2), (2,))
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Callable
+
+import numpy as np
+import sympy
+
+from .._errors import ProblemError, UnsupportedNonlinearityError
+from ..problems.forced import ForcedOscillator, ForcedSystem, check_forcing_frequency
+from ._period_map import PeriodMapValue
+
+__all__ = ["SmoothForcedFlow"]
+
+_SWITCHING = (sympy.Max, sympy.Min, sympy.Abs, sympy.Heaviside, sympy.sign, sympy.Piecewise)
+#: math-module stand-ins for functions lambdify's math printer does not know
+_MODULES = [{"Heaviside": lambda x, h=0.5: 1.0 if x > 0 else (0.0 if x < 0 else h),
+             "sign": lambda x: float((x > 0) - (x < 0))}, "math"]
+
+
+# --------------------------------------------------------------------------- #
+# the scalar law f(u): breakpoints and analytic pieces
+# --------------------------------------------------------------------------- #
+def _switch_arguments(atom: sympy.Basic) -> list[sympy.Expr]:
+    if isinstance(atom, (sympy.Max, sympy.Min)):
+        args = atom.args
+        return [a - b for i, a in enumerate(args) for b in args[i + 1:]]
+    if isinstance(atom, sympy.Piecewise):
+        out = []
+        for _, condition in atom.args:
+            if condition in (sympy.true, sympy.false):
+                continue
+            if not isinstance(condition, sympy.core.relational.Relational):
+                raise UnsupportedNonlinearityError(
+                    f"the Piecewise condition {condition} is not one comparison; write one comparison per piece")
+            out.append(condition.lhs - condition.rhs)
+        return out
+    return [atom.args[0]]
+
+
+def _choose(atom: sympy.Basic, u: sympy.Symbol, point: float) -> sympy.Expr:
+    """The branch of the switching ``atom`` that holds at ``u = point`` (an interior point of an interval)."""
+    def value(expr: sympy.Expr) -> float:
+        return float(sympy.N(expr.subs(u, point), 30))
+
+    if isinstance(atom, (sympy.Max, sympy.Min)):
+        values = [value(a) for a in atom.args]
+        pick = max if isinstance(atom, sympy.Max) else min
+        return atom.args[values.index(pick(values))]
+    if isinstance(atom, sympy.Abs):
+        return atom.args[0] if value(atom.args[0]) > 0 else -atom.args[0]
+    if isinstance(atom, sympy.Heaviside):
+        return sympy.S.One if value(atom.args[0]) > 0 else sympy.S.Zero
+    if isinstance(atom, sympy.sign):
+        return sympy.S.One if value(atom.args[0]) > 0 else -sympy.S.One
+    for expr, condition in atom.args:  # Piecewise
+        if condition is sympy.true or bool(condition.subs(u, point)):
+            return expr
+    raise UnsupportedNonlinearityError(f"{atom} is undefined at u = {point:g}; add a last piece (..., True)")
+
+
+class _ScalarLaw:
+    """f(u) with its breakpoints ``β_1 < … < β_m`` and on each interval the analytic piece and its derivative."""
+
+    def __init__(self, f: sympy.Expr, u: sympy.Symbol) -> None:
+        atoms = [a for a in sympy.preorder_traversal(f) if isinstance(a, _SWITCHING)]
+        points: set[float] = set()
+        for atom in atoms:
+            for argument in _switch_arguments(atom):
+                if argument.has(*_SWITCHING):
+                    raise UnsupportedNonlinearityError(f"f = {f}: nested switching functions are not supported")
+                if not argument.has(u):
+                    continue
+                try:
+                    roots = sympy.solve(argument, u)
+                except NotImplementedError:
+                    raise UnsupportedNonlinearityError(f"f = {f}: cannot find where {argument} changes sign") from None
+                for root in roots:
+                    number = complex(sympy.N(root, 30))
+                    if abs(number.imag) <= 1e-14 * (1 + abs(number.real)):
+                        points.add(float(number.real))
+        self.breakpoints = sorted(points)
+        edges = [-math.inf, *self.breakpoints, math.inf]
+        self.pieces: list[tuple[Callable[[float], float], Callable[[float], float], float]] = []
+        full = sympy.lambdify(u, f, modules=_MODULES)
+        for lower, upper in zip(edges[:-1], edges[1:]):
+            point = (lower + upper) / 2 if math.isfinite(lower) and math.isfinite(upper) else (
+                0.0 if not self.breakpoints else (upper - 1.0 if math.isinf(lower) else lower + 1.0))
+            piece = f.replace(lambda e: isinstance(e, _SWITCHING), lambda e, p=point: _choose(e, u, p)) if atoms else f
+            value = sympy.lambdify(u, piece, modules=_MODULES)
+            slope = sympy.lambdify(u, sympy.diff(piece, u), modules=_MODULES)
+            self.pieces.append((_real(value, full), _real(slope, None), point))
+
+    def region(self, u: float, v: float) -> int:
+        """Index of the interval holding u (on a breakpoint: the one v moves into)."""
+        index = int(np.searchsorted(self.breakpoints, u, side="right"))
+        if index > 0 and u == self.breakpoints[index - 1] and v < 0:
+            index -= 1
+        return index
+
+
+def _real(function: Callable[[float], Any], fallback: Callable[[float], Any] | None) -> Callable[[float], float]:
+    """``function`` as a real-valued float function; outside its interval (a fractional power of a negative
+    distance, met by a Runge–Kutta stage beyond the breakpoint) the whole law (or 0 for a derivative)."""
+    def call(u: float) -> float:
+        u = float(u)
+        try:
+            value = function(u)
+        except (ValueError, ZeroDivisionError):
+            value = complex("nan")
+        if isinstance(value, complex) or not math.isfinite(value):
+            return float(fallback(u)) if fallback is not None else 0.0
+        return float(value)
+
+    return call
+
+
+# --------------------------------------------------------------------------- #
+# the flow
+# --------------------------------------------------------------------------- #
+class SmoothForcedFlow:
+    """DOP853 period map (with monodromy, ∂/∂Ω, ∂/∂s) of a forced oscillator or forced unilateral system.
+
+    Parameters
+    ----------
+    problem : ForcedOscillator or ForcedSystem
+        With numeric coefficients (ω0, ζ, F and the parameters of f).
+    epsilon : float
+        The small parameter ε (any finite real).
+    rtol, atol : float
+        Tolerances of ``solve_ivp`` for the state and the sensitivities.
+
+    Attributes
+    ----------
+    dimension : int
+        2N.
+    n_dof : int
+        N.
+    breakpoints : tuple of float
+        The kinks of f (one degree of freedom); empty for a system (its switches are the gaps).
+    steps, evaluations : int
+        Accepted DOP853 steps and right-hand-side evaluations of every call so far.
+
+    Examples
+    --------
+    The linear oscillator ``u'' + 0.1 u' + u + ε u = ε cos(Ω t)`` has the monodromy ``exp(A T)``:
+
+    >>> import scipy.linalg
+    >>> from lindstedt.problems.forced import ForcedOscillator
+    >>> flow = SmoothForcedFlow(ForcedOscillator("u", omega0=1, zeta="1/20"), 0.5)
+    >>> value = flow.period_map([0.1, 0.0], 2.0)
+    >>> A = [[0, 1], [-1.5, -0.1]]
+    >>> bool(np.allclose(value.d_state, scipy.linalg.expm(np.array(A) * np.pi), atol=1e-11))
+    True
+    >>> SmoothForcedFlow(ForcedOscillator("Max(0, u - b)", omega0=1, params={"b": "1/5"}), 1.0).breakpoints
+    (0.2,)
+    """
+
+    def __init__(self, problem: ForcedOscillator | ForcedSystem, epsilon: float, *, rtol: float = 1e-12,
+                 atol: float = 1e-14) -> None:
+        if isinstance(epsilon, bool):
+            raise ProblemError(f"epsilon must be a real number, got {epsilon!r}")
+        try:
+            eps = float(epsilon)
+        except (TypeError, ValueError):
+            raise ProblemError(f"epsilon must be a real number, got {epsilon!r}") from None
+        if not math.isfinite(eps):
+            raise ProblemError(f"epsilon must be finite, got {epsilon!r}")
+        if not (isinstance(rtol, (int, float)) and isinstance(atol, (int, float)) and rtol > 0 and atol > 0):
+            raise ProblemError(f"rtol and atol must be positive numbers, got rtol={rtol!r}, atol={atol!r}")
+        self.problem, self.epsilon, self.rtol, self.atol = problem, eps, float(rtol), float(atol)
+        self.steps = 0
+        self.evaluations = 0
+        self._build()
+
+    def _build(self) -> None:
+        problem = self.problem
+        if isinstance(problem, ForcedOscillator):
+            omega0, zeta, forcing = problem.numeric_coefficients()
+            self.n_dof = 1
+            self._law = _ScalarLaw(problem.nonlinearity, problem.oscillator.variable)
+            self.breakpoints = tuple(self._law.breakpoints)
+            self._stiffness, self._damping, self._load = omega0 * omega0, 2.0 * zeta * omega0, forcing
+            self._scalar = True
+        elif isinstance(problem, ForcedSystem):
+            system = problem.system
+            self.n_dof = system.n_dof
+            M_inv = np.linalg.inv(system.M)
+            self._Km, self._Cm, self._Pm = M_inv @ system.K, M_inv @ problem.C, M_inv @ problem.P
+            self._A, self._b = np.array(system.A, dtype=float).reshape(-1, self.n_dof), np.array(system.b, dtype=float)
+            self._MW = M_inv @ np.array(system.W, dtype=float).reshape(self.n_dof, -1)
+            self.breakpoints = ()
+            self._scalar = False
+        else:
+            raise ProblemError(
+                f"problem must be a ForcedOscillator or a ForcedSystem (lindstedt.problems.forced), got {type(problem).__name__}")
+        self.dimension = 2 * self.n_dof
+
+    def __getstate__(self) -> dict[str, Any]:  # picklable for process pools: the lambdified law is rebuilt
+        return {key: value for key, value in self.__dict__.items() if key in ("problem", "epsilon", "rtol", "atol",
+                                                                                 "steps", "evaluations")}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._build()
+
+    def __repr__(self) -> str:
+        return f"SmoothForcedFlow({type(self.problem).__name__}, epsilon={self.epsilon:g}, rtol={self.rtol:g})"
+
+    # ------------------------------------------------------------------ regions and vector fields
+    def _region(self, z: np.ndarray) -> Any:
+        n = self.n_dof
+        if self._scalar:
+            return self._law.region(float(z[0]), float(z[1]))
+        gaps = self._A @ z[:n] - self._b
+        rates = self._A @ z[n:]
+        return tuple(bool(g > 0 or (g == 0 and r > 0)) for g, r in zip(gaps, rates))
+
+    def _fields(self, region: Any, frequency: float, scale: float, sensitivity: bool) -> Callable:
+        """The right-hand side of (z, Y) on one region (Y the 2N × (2N + 2) sensitivity block)."""
+        eps, n = self.epsilon, self.n_dof
+        if self._scalar:
+            value, slope, _ = self._law.pieces[region]
+            k, c, load = self._stiffness, self._damping, eps * scale * self._load
+            amplitude = eps * self._load
+
+            def scalar(t: float, y: np.ndarray) -> np.ndarray:
+                u, v = y[0], y[1]
+                phase = frequency * t
+                cosine = math.cos(phase)
+                a = load * cosine - k * u - c * v - eps * value(u)
+                if not sensitivity:
+                    return np.array((v, a))
+                stiff = k + eps * slope(u)
+                out = np.empty(10)
+                out[0], out[1] = v, a
+                Y = y[2:]
+                # Y laid out row-major: rows (u, v), 4 columns (z0_u, z0_v, Ω, s)
+                out[2:6] = Y[4:8]
+                out[6:10] = -stiff * Y[0:4] - c * Y[4:8]
+                out[8] -= load * t * math.sin(phase)
+                out[9] += amplitude * cosine
+                return out
+
+            return scalar
+        active = np.array(region, dtype=float)
+        Km = self._Km + eps * (self._MW * active) @ self._A if self._A.size else self._Km
+        offset = eps * (self._MW * active) @ self._b if self._A.size else np.zeros(n)
+        Cm, Pm, width = self._Cm, self._Pm, 2 * n + 2
+
+        def system(t: float, y: np.ndarray) -> np.ndarray:
+            x, v = y[:n], y[n:2 * n]
+            phase = frequency * t
+            a = eps * scale * math.cos(phase) * Pm - Km @ x - Cm @ v + offset
+            if not sensitivity:
+                return np.concatenate((v, a))
+            Y = y[2 * n:].reshape(2 * n, width)
+            dY = np.empty_like(Y)
+            dY[:n] = Y[n:]
+            dY[n:] = -Km @ Y[:n] - Cm @ Y[n:]
+            dY[n:, 2 * n] -= eps * scale * t * math.sin(phase) * Pm
+            dY[n:, 2 * n + 1] += eps * math.cos(phase) * Pm
+            return np.concatenate((v, a, dY.reshape(-1)))
+
+        return system
+
+    def _events(self, region: Any) -> list[tuple[Callable, Any]]:
+        """Terminal directional events leaving ``region``, each with the region entered."""
+        events: list[tuple[Callable, Any]] = []
+        if self._scalar:
+            points = self._law.breakpoints
+            if region > 0:
+                events.append((_event(lambda t, y, p=points[region - 1]: y[0] - p, -1), region - 1))
+            if region < len(points):
+                events.append((_event(lambda t, y, p=points[region]: y[0] - p, +1), region + 1))
+            return events
+        n = self.n_dof
+        for i, active in enumerate(region):
+            row, gap = self._A[i], self._b[i]
+            flipped = tuple(not a if j == i else a for j, a in enumerate(region))
+            events.append((_event(lambda t, y, row=row, gap=gap: float(row @ y[:n]) - gap, -1 if active else +1), flipped))
+        return events
+
+    def _acceleration(self, region: Any, t: float, z: np.ndarray, frequency: float, scale: float) -> np.ndarray:
+        return self._fields(region, frequency, scale, False)(t, z)[self.n_dof:]
+
+    def _saltation(self, old: Any, new: Any, t: float, z: np.ndarray, frequency: float, scale: float,
+                   event_index: int) -> np.ndarray | None:
+        """``S = I + Δ nᵀ/(nᵀ F⁻)`` where the field jumps across the switch (None where it is continuous)."""
+        n = self.n_dof
+        jump = self._acceleration(new, t, z, frequency, scale) - self._acceleration(old, t, z, frequency, scale)
+        if np.max(np.abs(jump)) <= 1e-15 * (1.0 + np.max(np.abs(z))):
+            return None
+        normal = np.zeros(2 * n)
+        if self._scalar:
+            normal[0] = 1.0
+        else:
+            spring = [i for i, (a, b) in enumerate(zip(old, new)) if a != b][0]
+            normal[:n] = self._A[spring]
+        rate = float(normal[:n] @ z[n:])
+        if rate == 0.0:
+            return None  # grazing: the saltation is singular; the crossing is tangential
+        S = np.eye(2 * n)
+        S[n:, :] += np.outer(jump, normal) / rate
+        return S
+
+    # ------------------------------------------------------------------ integration
+    def _integrate(self, state0: Any, frequency: float, periods: int, forcing_scale: float, sensitivity: bool,
+                   times: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None, dict[str, int], Any]:
+        from scipy.integrate import solve_ivp  # here, not at module level: import lindstedt stays light
+
+        n2 = self.dimension
+        z = np.array(state0, dtype=float).reshape(-1)
+        if z.shape != (n2,) or not np.all(np.isfinite(z)):
+            raise ProblemError(f"state0 must be {n2} finite numbers (X, X'), got {state0!r}")
+        frequency = check_forcing_frequency(frequency, "frequency")
+        if isinstance(periods, bool) or not isinstance(periods, (int, np.integer)) or periods < 1:
+            raise ProblemError(f"periods must be a positive integer, got {periods!r}")
+        scale = float(forcing_scale)
+        if not math.isfinite(scale):
+            raise ProblemError(f"forcing_scale must be finite, got {forcing_scale!r}")
+        end = 2.0 * math.pi * int(periods) / frequency
+        Y = np.hstack([np.eye(n2), np.zeros((n2, 2))]) if sensitivity else None
+        region = self._region(z)
+        t, counters = 0.0, {"steps": 0, "evaluations": 0, "arcs": 0, "switches": 0}
+        samples: list[np.ndarray] = []
+        while True:
+            rhs = self._fields(region, frequency, scale, sensitivity)
+            events = self._events(region)
+            y0 = np.concatenate((z, Y.reshape(-1))) if sensitivity else z
+            window = None if times is None else times[(times >= t) & (times < end)]
+            solution = solve_ivp(rhs, (t, end), y0, method="DOP853", rtol=self.rtol, atol=self.atol,
+                                 events=[e for e, _ in events] or None, dense_output=times is not None)
+            counters["arcs"] += 1
+            counters["steps"] += len(solution.t) - 1
+            counters["evaluations"] += int(solution.nfev)
+            if solution.status == -1:
+                raise ProblemError(f"DOP853 failed at t = {t:g}: {solution.message}")
+            hit = [(float(te[0]), k) for k, te in enumerate(solution.t_events or []) if len(te)]
+            t_next = min(hit)[0] if hit else end
+            if window is not None and window.size:
+                inside = window[window < t_next] if hit else window
+                if inside.size:
+                    samples.append(solution.sol(inside)[:n2].T)
+            if not hit:
+                y = solution.y[:, -1]
+                z = y[:n2]
+                Y = y[n2:].reshape(n2, n2 + 2) if sensitivity else None
+                break
+            t, k = min(hit)
+            y = solution.y_events[k][0]
+            z = y[:n2].copy()
+            Y = y[n2:].reshape(n2, n2 + 2).copy() if sensitivity else None
+            old, region = region, events[k][1]
+            counters["switches"] += 1
+            if self._scalar:
+                z[0] = self._law.breakpoints[min(old, region)]  # exactly on the breakpoint
+            if sensitivity:
+                S = self._saltation(old, region, t, z, frequency, scale, k)
+                if S is not None:
+                    Y = S @ Y
+        self.steps += counters["steps"]
+        self.evaluations += counters["evaluations"]
+        if sensitivity:
+            final_field = self._fields(region, frequency, scale, False)(end, z)
+            Y = Y.copy()
+            Y[:, n2] += final_field * (-end / frequency)
+        sampled = np.vstack(samples) if samples else np.empty((0, n2))
+        return z, Y, counters, (region, sampled)
+
+    def period_map(self, state0: Any, frequency: float, *, periods: int = 1, forcing_scale: float = 1.0,
+                   sensitivity: bool = True) -> PeriodMapValue:
+        """``Π(z0; Ω, s) = z(2πk/Ω)`` and, when ``sensitivity``, ``∂Π/∂z0``, ``∂Π/∂Ω`` and ``∂Π/∂s``.
+
+        Examples
+        --------
+        >>> from lindstedt.problems.forced import ForcedOscillator
+        >>> flow = SmoothForcedFlow(ForcedOscillator("u**3", omega0=1, zeta="1/20"), 0.5)
+        >>> value = flow.period_map([0.2, 0.0], 1.1, periods=2)
+        >>> sorted(value.counters), value.counters["switches"]
+        (['arcs', 'evaluations', 'steps', 'switches'], 0)
+        """
+        z, Y, counters, _ = self._integrate(state0, frequency, periods, forcing_scale, sensitivity)
+        if not sensitivity:
+            return PeriodMapValue(z, counters=counters)
+        n2 = self.dimension
+        return PeriodMapValue(z, Y[:, :n2].copy(), Y[:, n2].copy(), Y[:, n2 + 1].copy(), counters)
+
+    def sample(self, state0: Any, frequency: float, *, periods: int = 1, forcing_scale: float = 1.0,
+               samples: int = 256) -> tuple[np.ndarray, np.ndarray]:
+        """``(t, z(t))`` at ``samples`` equally spaced times of ``[0, kT)`` (dense output of each arc).
+
+        Examples
+        --------
+        >>> from lindstedt.problems.forced import ForcedOscillator
+        >>> flow = SmoothForcedFlow(ForcedOscillator("Max(0, u)", omega0=1), 3.0)
+        >>> t, z = flow.sample([1.0, 0.0], 1.0, samples=8)
+        >>> t.shape, z.shape, float(z[0, 0])
+        ((8,), (8, 2), 1.0)
+        """
+        if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
+            raise ProblemError(f"samples must be a positive integer, got {samples!r}")
+        frequency = check_forcing_frequency(frequency, "frequency")
+        times = np.arange(int(samples)) * (2.0 * math.pi * int(periods) / frequency / int(samples))
+        _, _, _, (_, sampled) = self._integrate(state0, frequency, periods, forcing_scale, False, times)
+        return times, sampled
+
+
+def _event(function: Callable[[float, np.ndarray], float], direction: int) -> Callable[[float, np.ndarray], float]:
+    function.terminal = True  # type: ignore[attr-defined]
+    function.direction = direction  # type: ignore[attr-defined]
+    return function
