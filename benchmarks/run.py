@@ -39,6 +39,7 @@ REGISTRY: dict[str, tuple[str, str]] = {
     "codegen-stability": ("bench_codegen_stability", "run"),
     "contact-laws": ("bench_contact_laws", "run"),
     "performance": ("bench_performance", "run"),
+    "forced": ("bench_forced", "run"),
 }
 
 

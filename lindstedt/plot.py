@@ -13,6 +13,9 @@ None) and returns the Axes; the data drawn are those of the package's results an
 * :func:`convergence` — max error against ε on log-log axes with the fitted slope
   (:class:`lindstedt.validate.ConvergenceFit`);
 * :func:`error_over_time` — ``|u_N(t) − u(t)|`` against t for expansions of several orders (the exact flow as u);
+* :func:`frequency_response` — forced responses (:class:`lindstedt.FrequencyResponse`): amplitude against Ω,
+  stable solid, unstable dashed, folds / period doublings / Neimark–Sacker points marked, with the
+  multiple-scales curve (:class:`lindstedt.FrequencyResponseCurve`) and its backbone overlaid;
 * :func:`branch` — an NNM branch (:class:`lindstedt.NNMBranch`): frequency against the continuation parameter,
   stable points solid, unstable dashed, jumps across internal-resonance tongues marked;
 * :func:`nnm_orbit` — one NNM (:class:`lindstedt.NNMResult`) over a period of the exact flow: the orbit in
@@ -37,7 +40,8 @@ import numpy as np
 
 from ._errors import LindstedtError
 
-__all__ = ["backbone", "branch", "convergence", "error_over_time", "nnm_orbit", "spectrum", "waveform"]
+__all__ = ["backbone", "branch", "convergence", "error_over_time", "frequency_response", "nnm_orbit", "spectrum",
+           "waveform"]
 
 
 def _pyplot() -> Any:
@@ -240,6 +244,83 @@ def error_over_time(expansions: Any, epsilon: float, t: Sequence[float], *, valu
     ax.set_xlabel("time $t$")
     ax.set_ylabel(r"$|u_N(t) - u(t)|$")
     ax.set_title(rf"error against the exact flow, $\varepsilon = {epsilon:g}$")
+    ax.legend()
+    return ax
+
+
+_BIFURCATION_MARKERS = {"fold": ("o", "fold"), "period-doubling": ("s", "period doubling"),
+                        "neimark-sacker": ("D", "Neimark–Sacker")}
+
+
+def frequency_response(responses: Any, *, curve: Any = None, epsilon: float | None = None, dof: int = 0,
+                       ax: Any = None) -> Any:
+    """Forced responses: the peak amplitude max_t |X_dof| against Ω; stable solid, unstable dashed, bifurcations marked.
+
+    Parameters
+    ----------
+    responses : FrequencyResponse or a sequence of them
+        Branches from :func:`lindstedt.frequency_response` (and :func:`lindstedt.switch_period_doubling`).
+    curve : FrequencyResponseCurve, optional
+        The multiple-scales prediction (:func:`lindstedt.frequency_response_curve`) drawn over the same Ω
+        range with its backbone, at ``epsilon`` (default: the first response's ε).
+    dof : int
+        The degree of freedom drawn (0-based).
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import lindstedt, lindstedt.plot
+    >>> problem = lindstedt.ForcedOscillator("u**3", omega0=1, zeta="1/20", forcing=1)
+    >>> response = lindstedt.frequency_response(problem, 0.9, 1.3, epsilon=0.2)
+    >>> ax = lindstedt.plot.frequency_response(response, curve=lindstedt.frequency_response_curve(problem))
+    >>> sorted({line.get_label() for line in ax.get_lines() if not line.get_label().startswith("_")})
+    ['backbone (multiple scales)', 'fold', 'multiple scales, order 1', 'stable', 'unstable']
+    """
+    ax = _axes(ax)
+    responses = [responses] if not isinstance(responses, (list, tuple)) else list(responses)
+    if not responses:
+        raise LindstedtError("frequency_response needs at least one FrequencyResponse")
+    drawn: set[str] = set()
+
+    def label(text: str) -> str | None:
+        if text in drawn:
+            return None
+        drawn.add(text)
+        return text
+
+    for index, response in enumerate(responses):
+        if not len(response):
+            continue
+        omega = np.asarray(response.frequencies, dtype=float)
+        peak = np.asarray(response.amplitudes, dtype=float).reshape(len(omega), -1)[:, dof]
+        stable = np.asarray(response.stable, dtype=bool)
+        colour = f"C{index}"
+        for k in range(len(omega) - 1):
+            both = stable[k] and stable[k + 1]
+            ax.plot(omega[k:k + 2], peak[k:k + 2], "-" if both else "--", color=colour,
+                    label=label("stable" if both else "unstable"))
+        for event in response.bifurcations:
+            marker, text = _BIFURCATION_MARKERS.get(event.kind, ("x", event.kind))
+            ax.plot([event.frequency], [np.asarray(event.amplitude, dtype=float).reshape(-1)[dof]], marker,
+                    color="k", markerfacecolor="none", label=label(text))
+    if curve is not None:
+        eps = float(epsilon if epsilon is not None else responses[0].epsilon)
+        low = min(float(np.min(r.frequencies)) for r in responses if len(r))
+        high = max(float(np.max(r.frequencies)) for r in responses if len(r))
+        grid = np.linspace(low, high, 400)
+        points = [(w, a) for w in grid for a in curve.displacement_maxima(w, eps)]
+        if points:
+            w_values, a_values = zip(*points)
+            ax.plot(w_values, a_values, ".", markersize=2, color="0.45", label=label(f"multiple scales, order {curve.order}"))
+            top = max(a_values)
+            amplitudes = np.linspace(top / 200, top, 200)
+            ax.plot([curve.backbone(a, eps) for a in amplitudes], amplitudes, ":", color="0.3",
+                    label=label("backbone (multiple scales)"))
+    ax.set_xlabel(r"forcing frequency $\Omega$")
+    ax.set_ylabel(rf"$\max_t |X_{{{dof + 1}}}|$" if dof else r"$\max_t |u|$")
+    first = responses[0]
+    ax.set_title(rf"frequency response, $\varepsilon = {first.epsilon:g}$" if first.epsilon is not None else "frequency response")
     ax.legend()
     return ax
 

@@ -24,7 +24,7 @@ def _subparsers(parser):
 def test_every_option_of_every_subcommand_has_help():
     parser = build_parser()
     commands = dict(_subparsers(parser))
-    assert set(commands) == {"expand", "nnm", "derive", "demo"}
+    assert set(commands) == {"expand", "nnm", "forced", "derive", "demo"}
     for name, sub in [("lindstedt", parser), *commands.items()]:
         for action in sub._actions:
             assert action.help and action.help.strip(), f"{name}: {action.option_strings or action.dest} has no help"

@@ -81,6 +81,21 @@ def test_error_over_time_needs_an_expansion():
         lindstedt.plot.error_over_time([], 0.1, [0.0, 1.0])
 
 
+def test_frequency_response_draws_the_textbook_linear_resonance():
+    # f = u: u'' + 2ζu' + (1 + ε)u = εF cos Ωt has the steady amplitude εF / √((1 + ε − Ω²)² + (2ζΩ)²) (textbook)
+    epsilon, zeta, forcing = 0.1, 0.05, 1.0
+    problem = lindstedt.ForcedOscillator("u", omega0=1, zeta=zeta, forcing=forcing)
+    response = lindstedt.frequency_response(problem, 0.8, 1.3, epsilon=epsilon)
+    ax = lindstedt.plot.frequency_response(response)
+    lines = [line for line in ax.get_lines() if line.get_linestyle() == "-"]
+    assert len(lines) == len(response) - 1 and lines[0].get_label() == "stable"
+    for line in lines:
+        omega, peak = np.asarray(line.get_xdata()), np.asarray(line.get_ydata())
+        exact = epsilon * forcing / np.sqrt((1 + epsilon - omega**2) ** 2 + (2 * zeta * omega) ** 2)
+        assert np.allclose(peak, exact, rtol=1e-9)  # the orbit's peak: shooting to 1e-10 (Hermite-refined samples)
+    assert not [line for line in ax.get_lines() if line.get_linestyle() == "--"]  # a linear response is stable
+
+
 def test_spectra_are_drawn_side_by_side_with_their_amplitudes():
     expansion = lindstedt.expand("Max(0, u)", order=3, a0=1, omega0=1)
     spectra = [expansion_spectrum(expansion, 0.2), exact_spectrum(expansion, 0.2)]

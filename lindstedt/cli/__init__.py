@@ -14,6 +14,11 @@ Sub-commands
     (``--eps E``: and the expansion's frequency at ε = E).
 ``lindstedt nnm SYSTEM.json --mode J --numeric (--a0 A | --energy E) --eps EPS [--format json]``
     The same NNM by shooting on the exact flow: frequency, period, release state, Floquet multipliers.
+``lindstedt forced F --eps E (--from W1 --to W2 | --at W) [--omega0 W] [--zeta Z] [--forcing F] [--param NAME=VALUE ...]
+[--method exact|multiple-scales] [--order 1|2] [--format pretty|plain|latex|json] [--figure PATH]``
+    Forced response of u'' + 2ζω0 u' + ω0² u + ε f(u) = ε F cos(Ω t): periodic responses by shooting on the
+    exact flow, continued in Ω through folds with bifurcations located (or one orbit at ``--at``), or the
+    closed-form multiple-scales curve and its steady amplitudes.
 ``lindstedt derive NAME [--order N] [--format text|latex|json] [--output DIR]`` / ``lindstedt derive --list``
     Named derivations (Duffing, u_+, gaps, grazing, NNMs, all modes).
 ``lindstedt demo [--figure PATH]``
@@ -26,7 +31,7 @@ non-zero: 2 for bad input (arguments, files, values outside what a method takes)
 unexpected internal error).  JSON output never contains NaN or infinities: a
 failed numerical result has ``null`` values with ``"success": false`` and a message.
 A validity warning of an evaluated expansion (``--eps``) is one line ``warning: …`` on stderr.
-Nothing is written to disk unless asked (``derive --output DIR``, ``demo --figure PATH``).
+Nothing is written to disk unless asked (``derive --output DIR``, ``demo --figure PATH``, ``forced --figure PATH``).
 """
 
 from __future__ import annotations
@@ -79,7 +84,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"lindstedt {__version__}", help="print the version and exit")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_ArgumentParser, metavar="COMMAND",
-                                     help="expand, nnm, derive or demo (lindstedt COMMAND --help for its options)")
+                                     help="expand, nnm, forced, derive or demo (lindstedt COMMAND --help for its options)")
 
     expand = commands.add_parser("expand", help="expand u'' + omega0^2 u + eps f(u) = 0 to a given order")
     expand.add_argument("f", help="the nonlinearity f(u), e.g. 'u**3' or 'u**3 + c*u**5'")
@@ -116,6 +121,10 @@ def build_parser() -> argparse.ArgumentParser:
     nnm.add_argument("--order", type=int, default=2, help="expansion order (default 2)")
     nnm.add_argument("--precision", type=int, default=30, help="decimal digits of the arithmetic (default 30)")
     nnm.add_argument("--format", choices=FORMATS, default="pretty", help=FORMAT_HELP + " (--numeric: pretty, plain and latex print its summary)")
+
+    from .forced import add_forced_parser
+
+    add_forced_parser(commands, FORMATS, FORMAT_HELP)
 
     derive = commands.add_parser(
         "derive", help="run a worked example of the source tree's derivations/ (LaTeX fragment + JSON coefficients)"
@@ -405,6 +414,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             output = _command_expand(arguments)
         elif arguments.command == "nnm":
             output = _command_nnm(arguments)
+        elif arguments.command == "forced":
+            from .forced import run_forced
+
+            output = run_forced(arguments, _parse_parameters(arguments.param))
         elif arguments.command == "derive":
             output = _command_derive(arguments)
         else:

@@ -225,16 +225,26 @@ def _orbit(count: _Counter, z: np.ndarray, frequency: float, scale: float, value
                        count.steps, count.evaluations, monodromy)
 
 
+#: a Newton step is at most this many times the size of the state (a guard against jumping far out, where a
+#: stiff law such as u³ makes the flow explode); halvings of a step that does not lower the residual
+_STEP_LIMIT = 2.0
+_HALVINGS = 6
+
+
 def _newton_fixed(count: _Counter, z: np.ndarray, frequency: float, scale: float, tol: float,
                   max_iterations: int) -> tuple[bool, str, np.ndarray, PeriodMapValue | None, int]:
-    """Newton on ``Π(z) − z = 0`` with the Jacobian ``∂Π/∂z − I``; (success, message, z, Π at z, iterations)."""
+    """Damped Newton on ``Π(z) − z = 0`` with the Jacobian ``∂Π/∂z − I``; (success, message, z, Π at z, iterations).
+
+    Each step is limited to :data:`_STEP_LIMIT` times the size of the state and halved (up to :data:`_HALVINGS`
+    times) until the residual decreases; the last trial's period map serves the next iteration.
+    """
     identity = np.eye(len(z))
     value = None
+    try:
+        value = count(z, frequency, scale)
+    except LindstedtError as error:
+        return False, f"the flow failed at the start: {error}", z, value, 0
     for iteration in range(max_iterations + 1):
-        try:
-            value = count(z, frequency, scale)
-        except LindstedtError as error:
-            return False, f"the flow failed at iteration {iteration}: {error}", z, value, iteration
         r = value.state - z
         norm = float(np.max(np.abs(r)))
         size = max(float(np.max(np.abs(z))), float(np.max(np.abs(value.state))), 1e-300)
@@ -248,7 +258,23 @@ def _newton_fixed(count: _Counter, z: np.ndarray, frequency: float, scale: float
             step = np.linalg.solve(value.d_state - identity, -r)
         except np.linalg.LinAlgError:
             return False, f"singular Jacobian ∂Π/∂z − I (a multiplier +1: a fold) at iteration {iteration}", z, value, iteration
-        z = z + step
+        length = float(np.max(np.abs(step)))
+        if length > _STEP_LIMIT * size:
+            step *= _STEP_LIMIT * size / length
+        for halving in range(_HALVINGS + 1):
+            trial = z + step
+            try:
+                trial_value = count(trial, frequency, scale)
+            except LindstedtError as error:
+                if halving == _HALVINGS:
+                    return False, f"the flow failed at iteration {iteration}: {error}", z, value, iteration
+                step /= 2
+                continue
+            trial_norm = float(np.max(np.abs(trial_value.state - trial)))
+            if math.isfinite(trial_norm) and (trial_norm < norm or halving == _HALVINGS):
+                break
+            step /= 2
+        z, value = trial, trial_value
     return False, f"no convergence: relative residual {norm / size:.1e} after {max_iterations} Newton iterations", z, value, max_iterations
 
 
@@ -265,7 +291,6 @@ def forced_periodic_orbit(flow: PeriodMap | ForcedOscillator | ForcedSystem, fre
         A flow, or a problem with ``epsilon``: its :func:`forced_flow` (exact for piecewise-linear laws).
     epsilon : float, optional
         ε, when ``flow`` is a problem.
-        E.g. :class:`~lindstedt.numerics.forced_smooth.SmoothForcedFlow`.
     frequency : float
         Ω > 0 (a :class:`~lindstedt.ParameterError` otherwise).
     initial_state : array_like, shape (2N,), optional

@@ -290,6 +290,32 @@ class FrequencyResponse(JsonExport):
         return summary + html_grid("points", ["index", "Ω", "s", "amplitude", "stable", "max|μ|",
                                               "bifurcation (→ next point)"], table)
 
+    def spectrum(self, index: int, *, dof: int = 0, samples: int = 1024) -> Any:
+        """The line spectrum of ``X_dof`` on the orbit ``points[index]`` (one period kT of the flow, sampled).
+
+        The exact flow's orbit over its whole period, rectangular window: the lines at multiples of Ω/k
+        (:func:`lindstedt.spectrum`; draw it with :func:`lindstedt.plot.spectrum`).
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> problem = lindstedt.ForcedOscillator("u", omega0=1, zeta="1/20", forcing=1)
+        >>> response = lindstedt.frequency_response(problem, 0.9, 1.1, epsilon=0.1)
+        >>> line = response.spectrum(0).peaks[0]   # linear: one line at Ω, |H| = εF/|1 + ε − Ω² + 2iζΩ| (textbook)
+        >>> round(line.angular_frequency, 12), round(line.amplitude, 10)
+        (0.9, 0.329332461)
+        """
+        from ..validate.spectra import spectrum
+
+        if self.flow is None:
+            from .._errors import LindstedtError
+
+            raise LindstedtError("this response has no flow (it was read back from JSON): recompute it to sample its orbits")
+        point = self.points[index]
+        _, states = self.flow.sample(point.state, point.frequency, periods=point.periods,
+                                     forcing_scale=point.forcing_scale, samples=samples)
+        return spectrum(states[:, dof], point.periods * 2 * np.pi / point.frequency, periods=point.periods)
+
     def to_dataframe(self) -> Any:
         """One row per point: Ω, s, stability, max|μ|, per degree of freedom i the peak, extremes, mean and
         first harmonic (``amplitude_i``, ``maximum_i``, … ``harmonic_i``), and ``bifurcation_after``.

@@ -228,7 +228,14 @@ class FrequencyResponseCurve(JsonExport):
             expression = getattr(self, name)
             if isinstance(expression, tuple):
                 raise TypeError(name)
-            self._cache[key] = sympy.lambdify(arguments, expression, modules="numpy")
+            function = sympy.lambdify(arguments, expression, modules="numpy")
+
+            def quiet(*values: Any, function: Callable[..., Any] = function) -> Any:
+                # a Piecewise becomes numpy.select, which evaluates every piece: the discarded pieces may be NaN
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    return function(*values)
+
+            self._cache[key] = quiet
         return self._cache[key]
 
     def _check_epsilon(self, epsilon: Any) -> float:
