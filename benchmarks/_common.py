@@ -238,4 +238,4 @@ def loglog_figure(path: Path, curves: Sequence[tuple[Sequence[float], Sequence[f
         legend.set_title("\n".join(notes), prop={"size": 8})
         legend._legend_box.align = "left"
     path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path)
+    figure.savefig(path, metadata={"Date": None} if path.suffix == ".svg" else None)  # reproducible files

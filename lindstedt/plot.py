@@ -254,7 +254,7 @@ _BIFURCATION_MARKERS = {"fold": ("o", "fold"), "period-doubling": ("s", "period 
 
 def frequency_response(responses: Any, *, curve: Any = None, epsilon: float | None = None, dof: int = 0,
                        ax: Any = None) -> Any:
-    """Forced responses: the peak amplitude max_t |X_dof| against Ω; stable solid, unstable dashed, bifurcations marked.
+    """Forced responses: the peak amplitude ``max_t |X_dof|`` against Ω; stable solid, unstable dashed, bifurcations marked.
 
     Parameters
     ----------

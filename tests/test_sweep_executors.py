@@ -7,6 +7,7 @@ it at every ε whatever runs the points, and report progress once per point.
 
 from __future__ import annotations
 
+import multiprocessing
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
 import pytest
@@ -14,6 +15,8 @@ import pytest
 import lindstedt
 
 EPSILONS = [0.05, 0.1, 0.2, 0.4, 0.8]
+#: fresh worker processes: forking a process that has loaded a multithreaded library (JAX, by other tests) can deadlock
+SPAWN = multiprocessing.get_context("spawn")
 
 
 def bilinear_frequency(epsilon: float) -> float:
@@ -68,7 +71,7 @@ def test_dask_local_cluster(system):
 def test_process_pools_pickle_the_task(system):
     # worker processes receive the system and options by pickling: a process pool and a Dask cluster of processes
     distributed = pytest.importorskip("distributed", reason="Dask is optional: pip install 'lindstedt[dask]'")
-    with ProcessPoolExecutor(2) as pool:
+    with ProcessPoolExecutor(2, mp_context=SPAWN) as pool:
         check(lindstedt.nnm_sweep(system, 1, EPSILONS, modal_amplitude=1.0, executor=pool))
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
@@ -149,7 +152,7 @@ def test_fitted_orders_on_a_process_pool_equal_the_serial_fits():
     expansion = lindstedt.expand("Max(0, u - 1/3)", order=1, a0=1, omega0=1)
     serial = fitted_convergence_order(expansion, [0.04, 0.02, 0.01])
     seen = []
-    with ProcessPoolExecutor(2) as pool:
+    with ProcessPoolExecutor(2, mp_context=SPAWN) as pool:
         pooled = fitted_convergence_order(expansion, [0.04, 0.02, 0.01], executor=pool, progress=lambda i, w, r: seen.append(i))
         grazing = lindstedt.expand("Max(0, u - 1)", order=1, a0=1, omega0=1)
         validity_serial = fitted_validity_exponent(grazing, [0.02, 0.01, 0.005], a1=1.0)

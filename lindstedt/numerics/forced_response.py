@@ -38,7 +38,7 @@ import math
 import time
 from collections.abc import Callable, Iterable
 from concurrent.futures import Executor
-from functools import partial
+from functools import lru_cache, partial
 from typing import Any
 
 import numpy as np
@@ -150,6 +150,27 @@ def _linear_guess(flow: Any, frequency: float, scale: float) -> np.ndarray:
         return guess if np.all(np.isfinite(guess)) else np.zeros(flow.dimension)
     except (LindstedtError, np.linalg.LinAlgError, TypeError, ValueError, AttributeError, IndexError):
         return np.zeros(flow.dimension)
+
+
+def _multiple_scales_guesses(flow: Any, frequency: float, scale: float) -> list[np.ndarray]:
+    """``z0 = (A cos γ, A Ω sin γ)`` of each first-order multiple-scales steady state ``u ≈ A cos(Ωt − γ)``, the
+    stable ones first (1 dof at the problem's own load only; none where the method does not apply)."""
+    problem, eps = getattr(flow, "problem", None), getattr(flow, "epsilon", None)
+    if not isinstance(problem, ForcedOscillator) or not eps or scale != 1.0:
+        return []
+    try:
+        states = _multiple_scales_curve(problem).steady_states(frequency, eps)
+    except LindstedtError:  # e.g. Ω far from ω0, or a law the method does not take
+        return []
+    ordered = sorted(states, key=lambda state: state.kind != "stable")
+    return [np.array([s.amplitude * math.cos(s.phase), s.amplitude * frequency * math.sin(s.phase)]) for s in ordered]
+
+
+@lru_cache(maxsize=16)
+def _multiple_scales_curve(problem: ForcedOscillator) -> Any:
+    from ..methods.multiple_scales import MultipleScales
+
+    return MultipleScales(order=1).frequency_response(problem)
 
 
 class _Counter:
@@ -295,7 +316,9 @@ def forced_periodic_orbit(flow: PeriodMap | ForcedOscillator | ForcedSystem, fre
         Ω > 0 (a :class:`~lindstedt.ParameterError` otherwise).
     initial_state : array_like, shape (2N,), optional
         Newton's start.  Default: the harmonic response of the problem linearised about X = 0; if
-        Newton fails from there, it starts again after ``transient_periods`` periods of the flow.
+        Newton fails from there (near a resonance), from each first-order multiple-scales steady state
+        (a 1-dof :class:`~lindstedt.ForcedOscillator`, stable states first), and then after
+        ``transient_periods`` periods of the flow.
     periods : int
         k.
     forcing_scale : float
@@ -334,6 +357,16 @@ def forced_periodic_orbit(flow: PeriodMap | ForcedOscillator | ForcedSystem, fre
         if z.shape != (flow.dimension,) or not np.all(np.isfinite(z)):
             raise ProblemError(f"initial_state must be {flow.dimension} finite numbers (X, X'), got {initial_state!r}")
     ok, message, z1, value, iterations = _newton_fixed(count, z, frequency, scale, tol, max_iterations)
+    if not ok and initial_state is None and k == 1:  # near resonance: start from the multiple-scales states
+        first = message
+        for guess in _multiple_scales_guesses(flow, frequency, scale):
+            ok, message, z1, value, more = _newton_fixed(count, guess, frequency, scale, tol, max_iterations)
+            iterations += more
+            if ok:
+                message = f"{message} (from a multiple-scales steady state; from the linear response: {first})"
+                break
+        if not ok:
+            message = first
     if not ok and transient_periods:
         first = message
         try:

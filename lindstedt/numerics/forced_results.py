@@ -308,8 +308,6 @@ class FrequencyResponse(JsonExport):
         from ..validate.spectra import spectrum
 
         if self.flow is None:
-            from .._errors import LindstedtError
-
             raise LindstedtError("this response has no flow (it was read back from JSON): recompute it to sample its orbits")
         point = self.points[index]
         _, states = self.flow.sample(point.state, point.frequency, periods=point.periods,
@@ -322,10 +320,8 @@ class FrequencyResponse(JsonExport):
 
         pandas is optional: ``pip install lindstedt[pandas]``.
         """
-        try:
-            import pandas
-        except ImportError as error:
-            raise LindstedtError("tables need pandas: pip install lindstedt[pandas] (or pip install pandas)") from error
+        from ..export.tables import dataframe
+
         after = {}
         for b in self.bifurcations:
             after.setdefault(b.index, []).append(b.kind)
@@ -338,4 +334,4 @@ class FrequencyResponse(JsonExport):
                     row[f"{name}_{i + 1}"] = float(value)
             row["bifurcation_after"] = "; ".join(after.get(k, []))
             rows.append(row)
-        return pandas.DataFrame(rows)
+        return dataframe(rows)
