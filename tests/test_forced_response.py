@@ -335,7 +335,7 @@ def test_exports(linear_flow):
 def test_dataframe_without_pandas_names_the_extra(linear_flow, monkeypatch):
     response = frequency_response(linear_flow, 0.9, 1.0, tol=1e-8)
     monkeypatch.setitem(sys.modules, "pandas", None)
-    with pytest.raises(LindstedtError, match=r"pip install lindstedt\[pandas\]"):
+    with pytest.raises(LindstedtError, match=r"pip install 'lindstedt\[pandas\]'"):
         response.to_dataframe()
 
 
