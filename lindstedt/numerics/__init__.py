@@ -74,8 +74,8 @@ from ._period_map import PeriodMap, PeriodMapValue
 from .forced_flow import ForcedFlow
 from .forced_smooth import SmoothForcedFlow
 from .forced_results import Bifurcation, ForcedOrbit, FrequencyResponse
+from .forced_setup import forced_flow
 from .forced_response import (
-    forced_flow,
     forced_periodic_orbit,
     frequency_response,
     frequency_response_sweep,
