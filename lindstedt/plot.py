@@ -309,7 +309,12 @@ def frequency_response(responses: Any, *, curve: Any = None, epsilon: float | No
         low = min(float(np.min(r.frequencies)) for r in responses if len(r))
         high = max(float(np.max(r.frequencies)) for r in responses if len(r))
         grid = np.linspace(low, high, 400)
-        points = [(w, a) for w in grid for a in curve.displacement_maxima(w, eps)]
+        points = []
+        for w in grid:
+            try:
+                points += [(w, a) for a in curve.displacement_maxima(w, eps)]
+            except LindstedtError:  # Ω outside the primary resonance the method covers: not drawn there
+                continue
         if points:
             w_values, a_values = zip(*points)
             ax.plot(w_values, a_values, ".", markersize=2, color="0.45", label=label(f"multiple scales, order {curve.order}"))

@@ -33,6 +33,7 @@ BUDGETS = {
     "backbone.ipynb": 60,
     "runtime_vs_error.ipynb": 60,
     "hertz_backbone.ipynb": 90,
+    "forced_response.ipynb": 60,
 }
 #: nbclient's limit for one cell
 CELL_TIMEOUT = 120
@@ -49,6 +50,7 @@ PLOT_FUNCTIONS = {
     "hertz_backbone.ipynb": {"backbone", "convergence", "waveform"},
     "validity_time.ipynb": {"convergence"},
     "runtime_vs_error.ipynb": set(),
+    "forced_response.ipynb": {"frequency_response", "spectrum"},
 }
 #: the figures (image/png outputs) each executed notebook shows, at least
 FIGURES = {
@@ -59,6 +61,7 @@ FIGURES = {
     "hertz_backbone.ipynb": 2,
     "validity_time.ipynb": 2,
     "runtime_vs_error.ipynb": 3,
+    "forced_response.ipynb": 3,
 }
 #: rich displays of results (the last expression of a cell): (mime type, fragments that one such output contains)
 DISPLAYS = {
@@ -74,6 +77,11 @@ DISPLAYS = {
         ("text/latex", [r"\ddot u + u + \varepsilon \max\left(0, u\right) = 0", r"\omega_{1} &= \frac{1}{4}"]),
     ],
     "fig3_lp_nnm_5dof.ipynb": [("text/latex", [r"\lambda_{1} &=", r"\omega(\varepsilon) &="])],
+    "forced_response.ipynb": [
+        ("text/html", ['<table class="lindstedt">', "<b>FrequencyResponse: "]),
+        # FrequencyResponseCurve._repr_latex_: the equation and the closed-form first harmonic of (A cos θ − 1/5)_+
+        ("text/latex", [r"\varepsilon F \cos \Omega t", r"\operatorname{acos}{\left(\frac{1}{5 A} \right)}"]),
+    ],
     "hertz_backbone.ipynb": [
         ("text/latex", ["Stretched contact arc", r"|u - b|^{3/2}"]),
         ("text/html", ['<table class="lindstedt">', "<b>StretchedArcSeries"]),
