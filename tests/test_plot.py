@@ -96,6 +96,16 @@ def test_frequency_response_draws_the_textbook_linear_resonance():
     assert not [line for line in ax.get_lines() if line.get_linestyle() == "--"]  # a linear response is stable
 
 
+def test_frequency_response_overlay_is_drawn_only_where_multiple_scales_applies():
+    # the method covers |Ω − ω0| < ω0/2 (primary resonance); a sweep to 1.6 must not fail, and draw nothing beyond
+    problem = lindstedt.ForcedOscillator("u", omega0=1, zeta="1/20", forcing=1)
+    response = lindstedt.frequency_response(problem, 0.8, 1.6, epsilon=0.1)
+    ax = lindstedt.plot.frequency_response(response, curve=lindstedt.frequency_response_curve(problem))
+    overlay = next(line for line in ax.get_lines() if line.get_label() == "multiple scales, order 1")
+    omega = np.asarray(overlay.get_xdata())
+    assert omega.min() >= 0.8 and omega.max() < 1.5 and len(omega) > 100
+
+
 def test_spectra_are_drawn_side_by_side_with_their_amplitudes():
     expansion = lindstedt.expand("Max(0, u)", order=3, a0=1, omega0=1)
     spectra = [expansion_spectrum(expansion, 0.2), exact_spectrum(expansion, 0.2)]
