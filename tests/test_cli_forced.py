@@ -8,11 +8,14 @@ Duffing, whose first harmonic is the textbook 3A³/4.
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from lindstedt.cli import main
+
+EXAMPLE = str(Path(__file__).resolve().parents[1] / "examples" / "forced_chain2.json")
 
 
 def textbook(omega: float, epsilon: float = 0.1, zeta: float = 0.05, forcing: float = 1.0) -> complex:
@@ -81,3 +84,27 @@ def test_bad_input_is_one_error_line(arguments, message, capsys):
     assert main(["forced", "u**3", "--eps", "0.1", *arguments]) == 2
     err = capsys.readouterr().err
     assert err.startswith("error: ") and message in err and err.count("\n") == 1
+
+
+def test_n_dof_forced_system_file_is_the_textbook_linear_response_below_its_gap(tmp_path, capsys):
+    # the spring's gap (100) is never reached: X = Re(H e^{iΩt}), H = (K − Ω²M + iΩC)⁻¹ ε P (textbook)
+    data = {"system": {"M": [[1, 0], [0, 1]], "K": [[2, -1], [-1, 2]], "A": [[1, 0]], "b": ["100"]},
+            "load": [1, 0], "rayleigh": ["0", "1/50"]}
+    path = tmp_path / "forced.json"
+    path.write_text(json.dumps(data), encoding="utf-8")
+    assert main(["forced", str(path), "--eps", "0.5", "--at", "1.3", "--format", "json"]) == 0
+    orbit = json.loads(capsys.readouterr().out)
+    K, M = np.array([[2.0, -1.0], [-1.0, 2.0]]), np.eye(2)
+    H = np.linalg.solve(K - 1.3**2 * M + 1j * 1.3 * K / 50, 0.5 * np.array([1.0, 0.0]))
+    assert np.allclose(orbit["harmonic_cos"], H.real, rtol=1e-10) and np.allclose(orbit["harmonic_sin"], -H.imag, rtol=1e-10)
+    assert main(["forced", str(path), "--eps", "0.5", "--from", "1.2", "--to", "1.4", "--format", "plain"]) == 0
+    assert "max|X1|" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (["--zeta", "0.1"], "a FORCED.json file holds its own damping and load"),
+    (["--method", "multiple-scales"], "--method multiple-scales is for one degree of freedom"),
+])
+def test_n_dof_file_refuses_one_dof_options(arguments, message, capsys):
+    assert main(["forced", EXAMPLE, "--eps", "0.5", "--at", "1", *arguments]) == 2
+    assert message in capsys.readouterr().err

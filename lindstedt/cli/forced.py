@@ -1,4 +1,5 @@
-"""``lindstedt forced``: the response of u'' + 2ζω0 u' + ω0² u + ε f(u) = ε F cos(Ω t).
+"""``lindstedt forced``: the response of u'' + 2ζω0 u' + ω0² u + ε f(u) = ε F cos(Ω t)
+(or, from a FORCED.json file, of M X'' + C X' + K X + ε W (A X − b)_+ = ε P cos(Ω t)).
 
 ``--method exact`` (default): periodic responses by shooting on the exact flow (event-driven for
 piecewise-linear f, DOP853 otherwise), continued over ``--from``/``--to`` with folds and bifurcations
@@ -25,7 +26,8 @@ def add_forced_parser(commands: Any, formats: tuple[str, ...], format_help: str)
     forced = commands.add_parser(
         "forced", help="forced response of u'' + 2 zeta omega0 u' + omega0^2 u + eps f(u) = eps F cos(Omega t)"
     )
-    forced.add_argument("f", help="the nonlinearity f(u), e.g. 'Max(0, u - 1/10)' or 'u**3'")
+    forced.add_argument("f", help="the nonlinearity f(u), e.g. 'Max(0, u - 1/10)' or 'u**3'; or FORCED.json, an N-dof "
+                                  "system {\"system\": {M, K, A, b}, \"load\": P, and rayleigh, modal_damping or C}")
     forced.add_argument("--omega0", default="1", help="linear angular frequency omega0 > 0 (default 1)")
     forced.add_argument("--zeta", default="0", help="damping ratio zeta >= 0 (default 0)")
     forced.add_argument("--forcing", default="1", help="forcing amplitude F != 0; the load is eps F cos(Omega t) (default 1)")
@@ -44,10 +46,25 @@ def add_forced_parser(commands: Any, formats: tuple[str, ...], format_help: str)
 
 
 def _problem(arguments: argparse.Namespace, parameters: dict[str, Any]) -> Any:
-    from ..problems.forced import ForcedOscillator
+    from ..problems.forced import ForcedOscillator, ForcedSystem
 
+    if arguments.f.endswith(".json"):
+        given = [option for option, value in (("--omega0", arguments.omega0 != "1"), ("--zeta", arguments.zeta != "0"),
+                                              ("--forcing", arguments.forcing != "1"), ("--param", parameters)) if value]
+        if given:
+            raise ProblemError(f"{', '.join(given)} describe a 1-dof problem; a FORCED.json file holds its own damping and load")
+        try:
+            with open(arguments.f, encoding="utf-8") as handle:
+                data = json.load(handle, parse_constant=_refuse_constant)
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as error:
+            raise ProblemError(f"cannot read the forced system file {arguments.f!r}: {error}") from None
+        return ForcedSystem.from_json_dict(data)
     return ForcedOscillator(arguments.f, omega0=arguments.omega0, zeta=arguments.zeta, forcing=arguments.forcing,
                             params=parameters)
+
+
+def _refuse_constant(name: str) -> None:
+    raise ProblemError(f"the forced system file contains {name}; every entry must be a finite real number")
 
 
 def _frequencies(arguments: argparse.Namespace) -> tuple[float | None, float | None, float | None]:
@@ -91,13 +108,22 @@ def _response_text(response: Any, pretty: bool) -> str:
     else:
         lines.append("bifurcations: none")
     if len(response):
-        header = f"{omega:>14s}{sep}{'max|u|':>14s}{sep}{'|u_1|':>14s}{sep}{'mean':>12s}{sep}stable"
+        dofs = min(len(response.points[0].amplitude), 4)
+        if dofs == 1:
+            header = f"{omega:>14s}{sep}{'max|u|':>14s}{sep}{'|u_1|':>14s}{sep}{'mean':>12s}{sep}stable"
+        else:
+            header = f"{omega:>14s}" + "".join(f"{sep}{f'max|X{i + 1}|':>14s}" for i in range(dofs)) + f"{sep}stable"
         lines += ["", header]
         events = {event.index for event in response.bifurcations}
         for k in _rows(len(response), events):
             point = response.points[k]
-            lines.append(f"{point.frequency:14.10g}{sep}{float(point.amplitude[0]):14.10g}{sep}"
-                         f"{float(point.harmonic[0]):14.10g}{sep}{float(point.mean[0]):12.4g}{sep}{'yes' if point.stable else 'no'}")
+            stable = "yes" if point.stable else "no"
+            if dofs == 1:
+                lines.append(f"{point.frequency:14.10g}{sep}{float(point.amplitude[0]):14.10g}{sep}"
+                             f"{float(point.harmonic[0]):14.10g}{sep}{float(point.mean[0]):12.4g}{sep}{stable}")
+            else:
+                lines.append(f"{point.frequency:14.10g}" + "".join(f"{sep}{float(a):14.10g}" for a in point.amplitude[:dofs])
+                             + f"{sep}{stable}")
     return "\n".join(lines)
 
 
@@ -106,14 +132,18 @@ def _orbit_text(orbit: Any, pretty: bool) -> str:
 
     omega = "Ω" if pretty else "Omega"
     largest = float(np.max(np.abs(orbit.multipliers))) if len(orbit.multipliers) else float("nan")
-    return "\n".join([
-        f"periodic response at {omega} = {orbit.frequency!r}: {'converged' if orbit.success else 'FAILED'} ({orbit.message})",
-        f"max u = {float(orbit.maximum[0])!r}, min u = {float(orbit.minimum[0])!r}, mean = {float(orbit.mean[0])!r}",
-        f"first harmonic: {float(orbit.harmonic_cos[0])!r} cos({omega} t) + {float(orbit.harmonic_sin[0])!r} sin({omega} t)"
-        f"  (|u_1| = {float(orbit.harmonic[0])!r})",
-        f"Floquet multipliers: max |mu| = {largest:.10g} -> {'stable' if orbit.stable else 'unstable'}",
-        f"state u(0), u'(0) = {[float(x) for x in orbit.state]}",
-    ])
+    lines = [f"periodic response at {omega} = {orbit.frequency!r}: {'converged' if orbit.success else 'FAILED'} ({orbit.message})"]
+    dofs = len(orbit.maximum)
+    for i in range(dofs):
+        name = "u" if dofs == 1 else f"X{i + 1}"
+        lines += [
+            f"{name}: max = {float(orbit.maximum[i])!r}, min = {float(orbit.minimum[i])!r}, mean = {float(orbit.mean[i])!r}",
+            f"{' ' * len(name)}  first harmonic {float(orbit.harmonic_cos[i])!r} cos({omega} t) + "
+            f"{float(orbit.harmonic_sin[i])!r} sin({omega} t)  (modulus {float(orbit.harmonic[i])!r})",
+        ]
+    lines += [f"Floquet multipliers: max |mu| = {largest:.10g} -> {'stable' if orbit.stable else 'unstable'}",
+              f"state (X(0), X'(0)) = {[float(x) for x in orbit.state]}"]
+    return "\n".join(lines)
 
 
 def _curve_output(curve: Any, arguments: argparse.Namespace, epsilon: float, start: float | None,
@@ -160,6 +190,9 @@ def run_forced(arguments: argparse.Namespace, parameters: dict[str, Any]) -> str
     if epsilon < 0:
         raise ProblemError(f"--eps must be ≥ 0, got {arguments.eps}")
     problem = _problem(arguments, parameters)
+    if arguments.method == "multiple-scales" and not hasattr(problem, "oscillator"):
+        raise ProblemError("--method multiple-scales is for one degree of freedom (f given as text); "
+                           "an N-dof FORCED.json is computed by --method exact")
     if arguments.method == "multiple-scales":
         from ..methods.multiple_scales import MultipleScales
 
@@ -209,7 +242,7 @@ def _draw(response: Any, problem: Any, path: str) -> None:
     figure = _figure_class(path)(figsize=(7, 4.5), layout="tight")
     ax = figure.subplots()
     try:
-        curve = MultipleScales(order=1).frequency_response(problem)
+        curve = MultipleScales(order=1).frequency_response(problem) if hasattr(problem, "oscillator") else None
     except LindstedtError:  # the overlay is optional: a law the method does not take is drawn without it
         curve = None
     plot.frequency_response(response, curve=curve, ax=ax)
