@@ -289,10 +289,20 @@ def frequency_response(responses: Any, *, curve: Any = None, epsilon: float | No
         drawn.add(text)
         return text
 
+    parameters = {response.parameter for response in responses}
+    if len(parameters) != 1:
+        raise LindstedtError("the responses drawn together must follow the same parameter (all 'frequency' or all 'forcing')")
+    parameter = parameters.pop()
+    for response in responses:
+        if len(response) and not 0 <= dof < len(response.points[0].amplitude):
+            raise LindstedtError(f"dof must be 0 … {len(response.points[0].amplitude) - 1}, got {dof!r}")
+    if curve is not None and (parameter != "frequency" or any(p.forcing_scale != 1.0 for r in responses for p in r.points[:1])):
+        raise LindstedtError("the multiple-scales curve is drawn against Ω at the problem's own load: draw responses "
+                             "with parameter='frequency' and forcing_scale=1, or leave curve out")
     for index, response in enumerate(responses):
         if not len(response):
             continue
-        omega = np.asarray(response.frequencies, dtype=float)
+        omega = np.asarray(response.parameter_values, dtype=float)
         peak = np.asarray(response.amplitudes, dtype=float).reshape(len(omega), -1)[:, dof]
         stable = np.asarray(response.stable, dtype=bool)
         colour = f"C{index}"
@@ -302,12 +312,14 @@ def frequency_response(responses: Any, *, curve: Any = None, epsilon: float | No
                     label=label("stable" if both else "unstable"))
         for event in response.bifurcations:
             marker, text = _BIFURCATION_MARKERS.get(event.kind, ("x", event.kind))
-            ax.plot([event.frequency], [np.asarray(event.amplitude, dtype=float).reshape(-1)[dof]], marker,
+            ax.plot([event.frequency if parameter == "frequency" else event.forcing_scale], [np.asarray(event.amplitude, dtype=float).reshape(-1)[dof]], marker,
                     color="k", markerfacecolor="none", label=label(text))
     if curve is not None:
+        if epsilon is None and responses[0].epsilon is None:
+            raise LindstedtError("give epsilon= for the multiple-scales curve (the responses do not say theirs)")
         eps = float(epsilon if epsilon is not None else responses[0].epsilon)
-        low = min(float(np.min(r.frequencies)) for r in responses if len(r))
-        high = max(float(np.max(r.frequencies)) for r in responses if len(r))
+        low = min(float(np.min(r.parameter_values)) for r in responses if len(r))
+        high = max(float(np.max(r.parameter_values)) for r in responses if len(r))
         grid = np.linspace(low, high, 400)
         points = []
         for w in grid:
@@ -322,7 +334,7 @@ def frequency_response(responses: Any, *, curve: Any = None, epsilon: float | No
             amplitudes = np.linspace(top / 200, top, 200)
             ax.plot([curve.backbone(a, eps) for a in amplitudes], amplitudes, ":", color="0.3",
                     label=label("backbone (multiple scales)"))
-    ax.set_xlabel(r"forcing frequency $\Omega$")
+    ax.set_xlabel(r"forcing frequency $\Omega$" if parameter == "frequency" else "load scale $s$ (the load is $s\\,\\varepsilon F$)")
     ax.set_ylabel(rf"$\max_t |X_{{{dof + 1}}}|$" if dof else r"$\max_t |u|$")
     first = responses[0]
     ax.set_title(rf"frequency response, $\varepsilon = {first.epsilon:g}$" if first.epsilon is not None else "frequency response")

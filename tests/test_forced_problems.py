@@ -83,3 +83,20 @@ def test_forced_system_damping_models():
 def test_forced_system_rejects_bad_input(kwargs, match):
     with pytest.raises(ProblemError, match=match):
         ForcedSystem(UnilateralSystem.chain(2, [(1, "1/10")]), **kwargs)
+
+
+@pytest.mark.parametrize("kwargs", [{"rayleigh": 0.01}, {"rayleigh": "0.01"}, {"modal_damping": 0.05},
+                                    {"modal_damping": "0.05"}, {"rayleigh": {"alpha": 0}}])
+def test_damping_given_as_a_scalar_or_text_names_the_form(kwargs):
+    with pytest.raises(ProblemError, match="must be a sequence"):
+        ForcedSystem(UnilateralSystem.chain(2, [(1, "1/10")]), [1, 0], **kwargs)
+
+
+def test_a_negative_forcing_is_a_phase_shift_with_the_same_peak():
+    import lindstedt
+
+    positive = lindstedt.frequency_response_curve("u**3", omega0=1, zeta="1/100", forcing="1/2")
+    negative = lindstedt.frequency_response_curve("u**3", omega0=1, zeta="1/100", forcing="-1/2")
+    assert negative.peak_amplitude == positive.peak_amplitude and str(positive.peak_amplitude) == "25*epsilon"
+    with pytest.raises(ProblemError, match="not both"):
+        lindstedt.frequency_response_curve(lindstedt.ForcedOscillator("u**3", omega0=1), zeta="1/100")

@@ -392,3 +392,12 @@ def test_second_order_slow_flow_extends_the_first():
         assert sympy.expand(scaled.coeff(EPSILON, 1) - lowered.coeff(EPSILON, 1)) == 0
         assert scaled.coeff(EPSILON, 0) == 0 and scaled.coeff(EPSILON, 3) == 0
     assert second.order == 2 and "O(\\varepsilon^{3})" in second.to_latex()
+
+
+def test_curve_pickles_after_it_has_been_evaluated():
+    import pickle
+
+    curve = frequency_response_curve("Max(0, u - 1/5)", omega0=1, zeta="1/100", forcing="1/2")
+    before = curve.amplitudes(1.02, 0.1)  # fills the memo of compiled closures
+    again = pickle.loads(pickle.dumps(curve))
+    assert again == curve and np.array_equal(again.amplitudes(1.02, 0.1), before)

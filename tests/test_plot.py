@@ -165,3 +165,18 @@ def test_nnm_orbit_of_the_seed_system_is_the_linear_mode_line_at_the_nonlinear_f
     assert point.frequency == pytest.approx(2 * lam * stiff / (lam + stiff), rel=1e-12)
     fundamental = min(lines.collections[0].get_segments(), key=lambda segment: segment[0, 0] if segment[0, 0] > 1e-9 else np.inf)
     assert fundamental[0, 0] == pytest.approx(point.frequency, rel=1e-12)
+
+
+def test_frequency_response_in_the_load_is_drawn_against_the_load():
+    # f = u: the steady amplitude is linear in the load scale s, s εF/|1 + ε − Ω² + 2iζΩ| (textbook)
+    problem = lindstedt.ForcedOscillator("u", omega0=1, zeta="1/20", forcing=1)
+    response = lindstedt.frequency_response(problem, 0.5, 2.0, epsilon=0.1, parameter="forcing", frequency=1.0)
+    ax = lindstedt.plot.frequency_response(response)
+    line = ax.get_lines()[0]
+    s = np.asarray(line.get_xdata())
+    assert "load scale" in ax.get_xlabel() and s.min() >= 0.5 - 1e-12 and s.max() <= 2.0 + 1e-12
+    assert np.allclose(line.get_ydata(), s * 0.1 / abs(1.1 - 1.0 + 0.1j), rtol=1e-9)
+    with pytest.raises(lindstedt.LindstedtError, match="problem's own load"):
+        lindstedt.plot.frequency_response(response, curve=lindstedt.frequency_response_curve(problem))
+    with pytest.raises(lindstedt.LindstedtError, match="dof must be"):
+        lindstedt.plot.frequency_response(response, dof=1)

@@ -163,3 +163,14 @@ def test_fitted_orders_on_a_process_pool_equal_the_serial_fits():
     assert validity_serial.success and abs(validity_serial.exponent + 0.5) < 0.15  # grazing: T ~ ε^(-1/2)
     assert (validity_pooled.validity_times == validity_serial.validity_times).all()
     assert validity_pooled.n_reference_solves == validity_serial.n_reference_solves
+
+
+def test_backbone_in_the_sqrt_eps_gauge_of_grazing():
+    # a0 = 1 with f = (u + 1)_+: the far turning point touches the breakpoint (ω(ε) in powers of √ε); the series of
+    # each order approaches the quadrature reference
+    from lindstedt.validate import backbone
+
+    curve = backbone("Max(0, u + 1)", [1.0], 0.01, order=2)
+    assert curve.success, curve.message
+    errors = curve.errors[:, 0]
+    assert errors[1] < errors[0] < 1e-2

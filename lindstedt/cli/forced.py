@@ -213,9 +213,9 @@ def run_forced(arguments: argparse.Namespace, parameters: dict[str, Any]) -> str
 
     at, start, stop = _frequencies(arguments)
     if at is not None:
-        orbit = forced_periodic_orbit(problem, at, epsilon=epsilon)
         if arguments.figure:
             raise ProblemError("--figure draws a sweep: give --from/--to instead of --at")
+        orbit = forced_periodic_orbit(problem, at, epsilon=epsilon)
         if arguments.format == "json":
             text = orbit.to_json()
         else:

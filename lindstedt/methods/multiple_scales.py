@@ -208,7 +208,6 @@ def first_harmonic(f: sympy.Expr, amplitude: sympy.Expr = AMPLITUDE) -> tuple[sy
         return value, (f"{names} (every breakpoint inside the orbit: contact regime)",)
     radii = sorted({abs(point) for point in breakpoints if point != 0})
     if not amplitude.is_Symbol:
-        radii = [r for r in radii if r < amplitude]
         sample = amplitude
         return sympy.simplify(_regime_value(intervals, amplitude, sample)), ()
     edges = [sympy.S.Zero, *radii]
@@ -496,7 +495,8 @@ def frequency_response_curve(
     """
     if isinstance(problem, ForcedOscillator):
         if omega0 is not None or zeta != 0 or forcing != 1 or params is not None:
-            raise TypeError("pass either a ForcedOscillator or f with its problem arguments, not both")
+            raise ProblemError("pass either a ForcedOscillator or f with its problem arguments (omega0=, zeta=, forcing=, "
+                               "params=), not both")
     else:
         problem = ForcedOscillator(problem, omega0=omega0, zeta=zeta, forcing=forcing, params=params)
     return MultipleScales(order).frequency_response(problem)

@@ -470,10 +470,17 @@ class ForcedFlow:
                     jump = np.zeros(dim)
                     # the oscillator's force ε f(u) jumps by ε J_i going up (acceleration: −ε J_i), −ε J_i going down
                     jump[n:] = self._mass_inverse @ np.ones(n) * (-self.epsilon * self._jumps[i] * (1 if after else -1))
-                    saltation = np.eye(dim) + np.outer(jump, np.concatenate([self._a[i], np.zeros(n)])) / (self._a[i] @ z[n:])
+                    crossing_rate = float(self._a[i] @ z[n:])
+                    if abs(crossing_rate) <= _SURFACE_FACTOR * _EPS * max(1.0, float(np.max(np.abs(z[n:])))):
+                        success, message = False, (f"stopped at t = {t}: a grazing crossing of the force jump of switch "
+                                                   f"{i} (zero crossing speed): the sensitivity is unbounded there")
+                        break
+                    saltation = np.eye(dim) + np.outer(jump, np.concatenate([self._a[i], np.zeros(n)])) / crossing_rate
                     jacobian = saltation @ jacobian
                     d_frequency = saltation @ d_frequency
                     d_scale = saltation @ d_scale
+            if not success:
+                break
             flags = tuple(new_flags)
         if success:
             message = f"reached t_end = {t_end} with {len(events)} switches in {n_arcs} arcs"

@@ -54,6 +54,8 @@ from .forced_setup import (
     _linear_guess,
     _multiple_scales_guesses,
     _positive,
+    _real,
+    _state,
     forced_flow,
 )
 
@@ -240,15 +242,13 @@ def forced_periodic_orbit(flow: PeriodMap | ForcedOscillator | ForcedSystem, fre
     flow = _flow_of(flow, epsilon)
     frequency = check_forcing_frequency(frequency, "frequency")
     k = _check_periods(periods)
-    scale = float(forcing_scale)
+    scale = _real(forcing_scale, "forcing_scale")
     tol, stability_tol = _positive(tol, "tol"), _positive(stability_tol, "stability_tol")
     count = _Counter(flow, k)
     if initial_state is None:
         z = _linear_guess(flow, frequency, scale)
     else:
-        z = np.array(initial_state, dtype=float).reshape(-1)
-        if z.shape != (flow.dimension,) or not np.all(np.isfinite(z)):
-            raise ProblemError(f"initial_state must be {flow.dimension} finite numbers (X, X'), got {initial_state!r}")
+        z = _state(initial_state, flow.dimension)
     ok, message, z1, value, iterations = _newton_fixed(count, z, frequency, scale, tol, max_iterations)
     if not ok and initial_state is None and k == 1:  # near resonance: start from the multiple-scales states
         first = message
@@ -603,7 +603,7 @@ def frequency_response(flow: PeriodMap | ForcedOscillator | ForcedSystem, start:
         start, stop = check_forcing_frequency(start, "start"), check_forcing_frequency(stop, "stop")
         if frequency is not None:
             raise ProblemError("parameter='frequency' varies Ω: do not also pass frequency=")
-        fixed = float(forcing_scale)
+        fixed = _real(forcing_scale, "forcing_scale")
         first = forced_periodic_orbit(flow, start, initial_state=initial_state, periods=k, forcing_scale=fixed, tol=tol,
                                       max_iterations=max_iterations, transient_periods=transient_periods,
                                       stability_tol=stability_tol, samples=samples)
@@ -612,9 +612,7 @@ def frequency_response(flow: PeriodMap | ForcedOscillator | ForcedSystem, start:
         if frequency is None:
             raise ProblemError("parameter='forcing' varies the load scale s at a fixed Ω: pass frequency=")
         fixed = omega = check_forcing_frequency(frequency, "frequency")
-        start, stop = float(start), float(stop)
-        if not (math.isfinite(start) and math.isfinite(stop)):
-            raise ProblemError(f"start and stop must be finite, got {start}, {stop}")
+        start, stop = _real(start, "start"), _real(stop, "stop")
         first = forced_periodic_orbit(flow, omega, initial_state=initial_state, periods=k, forcing_scale=start, tol=tol,
                                       max_iterations=max_iterations, transient_periods=transient_periods,
                                       stability_tol=stability_tol, samples=samples)

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from .._errors import LindstedtError
+from .._errors import LindstedtError, ProblemError
 from ..export.display import format_number, format_vector, html_grid, html_table, labelled_repr
 from ..export.json import JsonExport
 
@@ -307,6 +307,11 @@ class FrequencyResponse(JsonExport):
         """
         from ..validate.spectra import spectrum
 
+        if isinstance(index, bool) or not isinstance(index, (int, np.integer)) or not -len(self) <= index < len(self):
+            raise ProblemError(f"index must be a point of the branch, -{len(self)} … {len(self) - 1}, got {index!r}")
+        dofs = self.flow.dimension // 2 if self.flow is not None else len(self.points[index].amplitude)
+        if isinstance(dof, bool) or not isinstance(dof, (int, np.integer)) or not 0 <= dof < dofs:
+            raise ProblemError(f"dof must be a degree of freedom, 0 … {dofs - 1}, got {dof!r}")
         if self.flow is None:
             raise LindstedtError("this response has no flow (it was read back from JSON): recompute it to sample its orbits")
         point = self.points[index]

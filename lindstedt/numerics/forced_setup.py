@@ -97,6 +97,26 @@ def _positive(value: Any, name: str) -> float:
     return float(value)
 
 
+def _real(value: Any, name: str) -> float:
+    """A finite real number (a float, an int or a numeric string through the one parser), or a typed error."""
+    from ..problems.parsing import parse_float
+
+    if isinstance(value, (np.floating, np.integer)):
+        value = value.item()
+    return parse_float(value, what=name)
+
+
+def _state(value: Any, dimension: int, name: str = "initial_state") -> np.ndarray:
+    """``dimension`` finite numbers (X, X'), or a :class:`ProblemError` naming the form."""
+    try:
+        state = np.array(value, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        state = np.array([])
+    if state.shape != (dimension,) or not np.all(np.isfinite(state)):
+        raise ProblemError(f"{name} must be {dimension} finite numbers (X, X'), got {value!r}")
+    return state
+
+
 def _linear_guess(flow: Any, frequency: float, scale: float) -> np.ndarray:
     """``z0`` of the harmonic response of the problem linearised about X = 0 (zeros for an unknown flow)."""
     problem, eps = getattr(flow, "problem", None), getattr(flow, "epsilon", None)

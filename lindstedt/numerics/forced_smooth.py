@@ -38,12 +38,14 @@ from typing import Any, Callable
 import numpy as np
 import sympy
 
-from .._errors import ProblemError, UnsupportedNonlinearityError
+from .._errors import ConvergenceError, ProblemError, UnsupportedNonlinearityError
 from ..problems.forced import ForcedOscillator, ForcedSystem, check_forcing_frequency
 from ._period_map import PeriodMapValue
 
 __all__ = ["SmoothForcedFlow"]
 
+#: switches at one instant (no time advancing) before the run is declared stuck on a breakpoint (sliding)
+_MAX_INSTANT_SWITCHES = 50
 _SWITCHING = (sympy.Max, sympy.Min, sympy.Abs, sympy.Heaviside, sympy.sign, sympy.Piecewise)
 #: math-module stand-ins for functions lambdify's math printer does not know
 _MODULES = [{"Heaviside": lambda x, h=0.5: 1.0 if x > 0 else (0.0 if x < 0 else h),
@@ -355,6 +357,7 @@ class SmoothForcedFlow:
         Y = np.hstack([np.eye(n2), np.zeros((n2, 2))]) if sensitivity else None
         region = self._region(z)
         t, counters = 0.0, {"steps": 0, "evaluations": 0, "arcs": 0, "switches": 0}
+        stalled = 0
         samples: list[np.ndarray] = []
         while True:
             rhs = self._fields(region, frequency, scale, sensitivity)
@@ -367,8 +370,17 @@ class SmoothForcedFlow:
             counters["steps"] += len(solution.t) - 1
             counters["evaluations"] += int(solution.nfev)
             if solution.status == -1:
-                raise ProblemError(f"DOP853 failed at t = {t:g}: {solution.message}")
+                raise ConvergenceError(f"DOP853 failed at t = {t:g}: {solution.message}")
             hit = [(float(te[0]), k) for k, te in enumerate(solution.t_events or []) if len(te)]
+            if hit and min(hit)[0] <= t:
+                stalled += 1
+                if stalled > _MAX_INSTANT_SWITCHES:
+                    raise ConvergenceError(
+                        f"the motion sticks on a breakpoint at t = {t:g} ({stalled} switches without time advancing: "
+                        "a sliding motion, which this flow does not follow)"
+                    )
+            else:
+                stalled = 0
             t_next = min(hit)[0] if hit else end
             if window is not None and window.size:
                 inside = window[window < t_next] if hit else window

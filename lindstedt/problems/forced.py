@@ -256,8 +256,12 @@ class ForcedSystem:
         given = [name for name, value in (("rayleigh", rayleigh), ("modal_damping", modal_damping), ("C", C)) if value is not None]
         if len(given) > 1:
             raise ProblemError(f"give one damping model, not {' and '.join(given)}")
+        for name, value in (("rayleigh", rayleigh), ("modal_damping", modal_damping)):
+            if value is not None and (isinstance(value, (str, bytes, Mapping)) or not hasattr(value, "__len__")):
+                example = "rayleigh=(alpha, beta)" if name == "rayleigh" else "modal_damping=[zeta_1, …, zeta_N]"
+                raise ProblemError(f"{name} must be a sequence, e.g. {example}, got {value!r}")
         if rayleigh is not None:
-            if isinstance(rayleigh, (str, bytes)) or len(rayleigh) != 2:
+            if len(rayleigh) != 2:
                 raise ProblemError("rayleigh must be a pair (alpha, beta), C = alpha*M + beta*K")
             alpha, beta = (_nonnegative(value, name) for value, name in zip(rayleigh, ("alpha", "beta")))
             C_exact = sympy.ImmutableMatrix(alpha * system.M_exact + beta * system.K_exact)

@@ -169,6 +169,15 @@ class FrequencyResponseCurve(JsonExport):
     max_displacement: sympy.Expr
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Picklable (process pools, Dask): the memo of compiled closures is rebuilt where it is needed."""
+        state = dict(self.__dict__)
+        state["_cache"] = {}
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+
     # -- construction ----------------------------------------------------------------------
     @classmethod
     def build(
@@ -191,7 +200,7 @@ class FrequencyResponseCurve(JsonExport):
         relation = (2 * omega0**2 * zeta * A / epsilon) ** 2 + (f1 - 2 * omega0 * sigma * A) ** 2 - forcing**2
         phase_sine = 2 * omega0**2 * zeta * A / (epsilon * forcing)
         phase_cosine = (f1 - 2 * omega0 * sigma * A) / forcing
-        peak = epsilon * forcing / (2 * zeta * omega0**2) if zeta != 0 else sympy.oo
+        peak = epsilon * sympy.Abs(forcing) / (2 * zeta * omega0**2) if zeta != 0 else sympy.oo  # F < 0: a phase shift
         trace = -2 * zeta * omega0
         distance = sigma - backbone
         determinant = zeta**2 * omega0**2 + epsilon**2 * distance**2 - epsilon**2 * A * sympy.diff(g, A) * distance / (2 * omega0)
@@ -349,13 +358,15 @@ class FrequencyResponseCurve(JsonExport):
         """
         sigma, eps = self._detuning_of(Omega, epsilon)
         key = ("roots", sigma, eps)
-        if key not in self._cache:
+        roots = self._cache.get(key)
+        if roots is None:
             if len(self._cache) > 256:  # keep the memo of roots small
-                for stale in [k for k in self._cache if isinstance(k, tuple) and k[0] == "roots"]:
-                    del self._cache[stale]
+                for stale in [k for k in list(self._cache) if isinstance(k, tuple) and k[0] == "roots"]:
+                    self._cache.pop(stale, None)  # another thread may have dropped it already
             polynomial = self.problem.oscillator.is_polynomial
-            self._cache[key] = self._polynomial_roots(sigma, eps) if polynomial else self._bracketed_roots(sigma, eps)
-        return self._cache[key].copy()
+            roots = self._polynomial_roots(sigma, eps) if polynomial else self._bracketed_roots(sigma, eps)
+            self._cache[key] = roots
+        return roots.copy()
 
     def steady_states(self, Omega: Any, epsilon: Any) -> tuple[SteadyState, ...]:
         """Every steady state at Ω: amplitude, branch, phase, stability and ``max_t u``, by increasing amplitude.
@@ -679,7 +690,7 @@ def _second_order(
         branches.append(first + epsilon * correction)
     # peak: A1 + ε A2 with A2 = −H2/(∂_A H1) at (A1, σ_b(A1)), where ∂_σ H1 = 0
     if zeta != 0:
-        a1 = forcing / (2 * zeta_hat * omega0**2)
+        a1 = sympy.Abs(forcing) / (2 * zeta_hat * omega0**2)
         sigma1 = (f1 / (2 * omega0 * A)).subs(A, a1)
         at_peak = {A: a1, sigma: sigma1}
         a2 = -(h2_hat.subs(at_peak)) / sympy.diff(h1_hat, A).subs(at_peak)

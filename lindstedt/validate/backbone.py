@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 from functools import partial
 from typing import Any, Callable, Mapping, Sequence
@@ -100,25 +101,29 @@ class Backbone(JsonExport):
 
 
 def _amplitude_task(a0: float, *, f: Any, order: int, omega0: Any, params: Any, epsilon: float, reference: bool,
-                    precision: int) -> tuple[list[float] | None, float, float, str]:
-    """(ω_1 … ω_N truncated at ε, exact ω, its estimate, failure text) at one amplitude (picklable)."""
+                    precision: int) -> tuple[list[float] | None, float, float, str, str]:
+    """(ω_1 … ω_N truncated at ε, exact ω, its estimate, failure text, validity warning) at one amplitude (picklable)."""
     with MPMATH_LOCK:  # the quadrature and the engine set mpmath's process-wide precision
         return _amplitude_outcome(a0, f=f, order=order, omega0=omega0, params=params, epsilon=epsilon,
                                   reference=reference, precision=precision)
 
 
 def _amplitude_outcome(a0: float, *, f: Any, order: int, omega0: Any, params: Any, epsilon: float, reference: bool,
-                       precision: int) -> tuple[list[float] | None, float, float, str]:
+                       precision: int) -> tuple[list[float] | None, float, float, str, str]:
     from .._errors import LindstedtError
     from ..methods.lindstedt_poincare import expand
+    from ..results.accuracy import ExpansionValidityWarning
     from ..references.quadrature import conservative_frequency
 
-    failure = ""
+    failure = note = ""
     series: list[float] | None = None
     try:
-        omega = [float(value) for value in expand(f, order=order, a0=a0, omega0=omega0, params=params).omega]
-        partial_sums = np.cumsum([value * epsilon**k for k, value in enumerate(omega)])
-        series = [float(value) for value in partial_sums[1:]]
+        expansion = expand(f, order=order, a0=a0, omega0=omega0, params=params)
+        with warnings.catch_warnings(record=True) as caught:  # in any gauge (√ε at grazing), with its warnings
+            warnings.simplefilter("always", ExpansionValidityWarning)
+            series = [float(expansion.frequency(epsilon, order=n)) for n in range(1, order + 1)]
+        if caught:
+            note = f"a0 = {a0:g}: {caught[-1].message}"
     except LindstedtError as error:
         failure = f"a0 = {a0:g}: expansion: {error}"
     exact = estimate = math.nan
@@ -130,7 +135,7 @@ def _amplitude_outcome(a0: float, *, f: Any, order: int, omega0: Any, params: An
             exact, estimate = float(value), float(error_estimate)
         except LindstedtError as error:
             failure = (failure + "; " if failure else "") + f"a0 = {a0:g}: reference: {error}"
-    return series, exact, estimate, failure
+    return series, exact, estimate, failure, note
 
 
 def backbone(
@@ -189,14 +194,16 @@ def backbone(
                    reference=reference, precision=precision)
     outcomes = sweep_map(task, values, executor=executor, progress=progress, description="backbone")
     series = np.full((order, len(values)), math.nan)
-    for j, (column, _, _, _) in enumerate(outcomes):
+    for j, (column, *_) in enumerate(outcomes):
         if column is not None:
             series[:, j] = column
-    failures = [failure for *_, failure in outcomes if failure]
+    failures = [outcome[3] for outcome in outcomes if outcome[3]]
+    notes = [outcome[4] for outcome in outcomes if outcome[4]]
     return Backbone(
         success=not failures,
         message="; ".join(failures) if failures else f"{len(values)} amplitudes, orders 1…{order}"
-        + (f", exact frequency to {precision} digits" if reference else ", no reference"),
+        + (f", exact frequency to {precision} digits" if reference else ", no reference")
+        + ("; validity warnings: " + "; ".join(notes) if notes else ""),
         epsilon=float(epsilon),
         amplitudes=np.array(values),
         orders=tuple(range(1, order + 1)),
