@@ -363,3 +363,22 @@ def test_neimark_sacker_on_a_two_dof_chain():
     first, second = found
     stable = response.stable
     assert stable[first.index] and not stable[first.index + 1] and not stable[second.index] and stable[second.index + 1]
+
+
+def test_a_motion_stuck_on_a_force_jump_is_a_convergence_error_not_a_hang():
+    # ε·2·H(u) pushes back at u = 0 from both sides once u' = 0 there: a sliding motion, which the flow does not follow
+    from lindstedt import ConvergenceError
+    from lindstedt.numerics import SmoothForcedFlow
+
+    flow = SmoothForcedFlow(ForcedOscillator("2*Heaviside(u)", omega0=1, zeta="1/10", forcing=1), 0.5)
+    with pytest.raises(ConvergenceError, match="sticks on a breakpoint"):
+        flow.period_map([0.0, 0.0], 1.0)
+
+
+def test_spectrum_checks_the_point_and_the_degree_of_freedom():
+    problem = ForcedOscillator("u", omega0=1, zeta="1/20", forcing=1)
+    response = frequency_response(problem, 0.9, 1.1, epsilon=0.1)
+    with pytest.raises(ProblemError, match="dof must be"):
+        response.spectrum(0, dof=1)  # would be the velocity u' of a 1-dof orbit
+    with pytest.raises(ProblemError, match="index must be"):
+        response.spectrum(len(response))
