@@ -401,3 +401,10 @@ def test_curve_pickles_after_it_has_been_evaluated():
     before = curve.amplitudes(1.02, 0.1)  # fills the memo of compiled closures
     again = pickle.loads(pickle.dumps(curve))
     assert again == curve and np.array_equal(again.amplitudes(1.02, 0.1), before)
+
+
+def test_frequencies_outside_the_primary_resonance_are_not_returned():
+    # the method covers |Ω − ω0| < ω0/2; σ_b = 3A²/8 (textbook Duffing) puts A = 10, ε = 0.1 at Ω = 4.75
+    curve = frequency_response_curve("u**3", omega0=1, zeta="1/100", forcing=1)
+    inside, outside = curve.backbone([1.0, 10.0], 0.1)
+    assert inside == pytest.approx(1 + 0.1 * 3 / 8, rel=1e-15) and np.isnan(outside)

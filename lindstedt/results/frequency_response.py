@@ -268,16 +268,22 @@ class FrequencyResponseCurve(JsonExport):
         return np.asarray(value, dtype=float) + 0.0 * amplitude
 
     def frequency(self, A: Any, epsilon: Any, branch: str = "upper") -> np.ndarray:
-        """The forcing frequency ``Ω = ω0 + ε σ_±(A)`` at which A is a steady amplitude."""
+        """The forcing frequency ``Ω = ω0 + ε σ_±(A)`` at which A is a steady amplitude (NaN where there is none,
+        and where ``|Ω − ω0| ≥ ω0/2``: outside the primary resonance the method covers)."""
         eps = self._check_epsilon(epsilon)
-        return float(self.problem.omega0) + eps * self.detuning(A, eps, branch)
+        return self._within_range(float(self.problem.omega0) + eps * self.detuning(A, eps, branch))
 
     def backbone(self, A: Any, epsilon: Any) -> np.ndarray:
-        """The backbone frequency ``ω0 + ε σ_b(A)`` (the free oscillation of amplitude A)."""
+        """The backbone frequency ``ω0 + ε σ_b(A)`` (the free oscillation of amplitude A; NaN where
+        ``|Ω − ω0| ≥ ω0/2``, outside the primary resonance the method covers)."""
         amplitude = _amplitude_array(A)
         eps = self._check_epsilon(epsilon)
         value = self._numeric("backbone_detuning", (AMPLITUDE, EPSILON))(amplitude, eps)
-        return float(self.problem.omega0) + eps * (np.asarray(value, dtype=float) + 0.0 * amplitude)
+        return self._within_range(float(self.problem.omega0) + eps * (np.asarray(value, dtype=float) + 0.0 * amplitude))
+
+    def _within_range(self, omega: np.ndarray) -> np.ndarray:
+        omega0 = float(self.problem.omega0)
+        return np.where(np.abs(omega - omega0) < DETUNING_LIMIT * omega0, omega, np.nan)
 
     def stability(self, A: Any, epsilon: Any, branch: str = "upper") -> Stability:
         """Trace and determinant of the slow flow's Jacobian at the fixed point (A, σ_±(A)), and its kind.
