@@ -54,6 +54,7 @@ from ..problems.forced import ForcedOscillator, ForcedSystem, check_forcing_freq
 from ..problems.piecewise_linear import decompose_piecewise_linear
 from ._period_map import PeriodMapValue
 from .flow import FlowResult, SwitchEvent
+from .forced_setup import _real
 from .switching import _Bracket, _Counters, _earliest_switch, _first_exit, _SearchFailure
 
 __all__ = ["ForcedFlow"]
@@ -148,14 +149,9 @@ class ForcedFlow:
     """
 
     def __init__(self, problem: ForcedSystem | ForcedOscillator, epsilon: float, *, max_arcs: int = 1_000_000) -> None:
-        if isinstance(epsilon, bool):
-            raise ParameterError(f"epsilon must be a number ≥ 0, got {epsilon!r}")
-        try:
-            eps = float(epsilon)
-        except (TypeError, ValueError):
-            raise ParameterError(f"epsilon must be a number ≥ 0 such as 0.1, got {epsilon!r}") from None
-        if not math.isfinite(eps) or eps < 0.0:
-            raise ParameterError(f"epsilon must be finite and ≥ 0 (the size of the nonlinearity and of the load), got {epsilon!r}; e.g. epsilon=0.1")
+        eps = _real(epsilon, "epsilon")
+        if eps < 0.0:
+            raise ParameterError(f"epsilon must be ≥ 0 (the size of the nonlinearity and of the load), got {epsilon!r}; e.g. epsilon=0.1")
         self.problem = problem
         self.epsilon = eps
         self.max_arcs = int(max_arcs)

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from .._errors import LindstedtError, ProblemError
+from .._errors import LindstedtError, ParameterError, ProblemError
 from ..problems.forced import ForcedOscillator, ForcedSystem
 from ._period_map import PeriodMap
 
@@ -98,12 +98,18 @@ def _positive(value: Any, name: str) -> float:
 
 
 def _real(value: Any, name: str) -> float:
-    """A finite real number (a float, an int or a numeric string through the one parser), or a typed error."""
+    """A finite real number (a float, an int or a numeric string through the one parser), or a
+    :class:`ParameterError` naming the form (the one reading of ε, load scales and ranges of the forced numerics)."""
     from ..problems.parsing import parse_float
 
     if isinstance(value, (np.floating, np.integer)):
         value = value.item()
-    return parse_float(value, what=name)
+    try:
+        return parse_float(value, what=name)
+    except ParameterError:
+        raise
+    except ProblemError as error:
+        raise ParameterError(str(error)) from None
 
 
 def _state(value: Any, dimension: int, name: str = "initial_state") -> np.ndarray:

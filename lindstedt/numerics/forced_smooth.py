@@ -39,6 +39,7 @@ import numpy as np
 import sympy
 
 from .._errors import ConvergenceError, ProblemError, UnsupportedNonlinearityError
+from .forced_setup import _real as _real_number
 from ..problems.forced import ForcedOscillator, ForcedSystem, check_forcing_frequency
 from ._period_map import PeriodMapValue
 
@@ -192,14 +193,7 @@ class SmoothForcedFlow:
 
     def __init__(self, problem: ForcedOscillator | ForcedSystem, epsilon: float, *, rtol: float = 1e-12,
                  atol: float = 1e-14) -> None:
-        if isinstance(epsilon, bool):
-            raise ProblemError(f"epsilon must be a real number, got {epsilon!r}")
-        try:
-            eps = float(epsilon)
-        except (TypeError, ValueError):
-            raise ProblemError(f"epsilon must be a real number, got {epsilon!r}") from None
-        if not math.isfinite(eps):
-            raise ProblemError(f"epsilon must be finite, got {epsilon!r}")
+        eps = _real_number(epsilon, "epsilon")
         if not (isinstance(rtol, (int, float)) and isinstance(atol, (int, float)) and rtol > 0 and atol > 0):
             raise ProblemError(f"rtol and atol must be positive numbers, got rtol={rtol!r}, atol={atol!r}")
         self.problem, self.epsilon, self.rtol, self.atol = problem, eps, float(rtol), float(atol)
