@@ -65,7 +65,7 @@ plot_rcparams = {"figure.figsize": (7.0, 4.0)}
 
 # the gallery: notebooks executed at every build, a failing cell (or assertion) fails the build
 nb_execution_mode = "force"
-nb_execution_timeout = 120  # seconds per cell (tests/test_notebooks.py: CELL_TIMEOUT)
+nb_execution_timeout = 600  # seconds per cell: a hang guard, far above normal (tests/test_notebooks.py: CELL_TIMEOUT)
 nb_execution_raise_on_error = True
 nb_execution_show_tb = True
 nb_merge_streams = True

@@ -10,7 +10,6 @@ import runpy
 import shutil
 import subprocess
 import sys
-import time
 
 import pytest
 
@@ -20,8 +19,6 @@ PAGES = sorted(DOCS.glob("*.rst"))
 NOTEBOOKS = sorted(path.stem for path in (ROOT / "notebooks").glob("*.ipynb"))
 #: the lindstedt.plot functions the figures page draws with
 PLOT_FUNCTIONS = ("backbone", "waveform", "error_over_time", "spectrum", "convergence", "branch", "nnm_orbit")
-#: seconds one ``.. plot::`` figure may take (the site's build time stays small)
-FIGURE_BUDGET = 5.0
 
 
 def test_the_pages_exist():
@@ -68,22 +65,19 @@ def test_the_figures_page_draws_with_the_plotting_api():
 
 
 @pytest.mark.parametrize("page, number, code", FIGURE_BLOCKS, ids=[f"{p}-{n}" for p, n, _ in FIGURE_BLOCKS])
-def test_figure_code_runs_fast(page, number, code):
-    """What the plot directive runs at build time: it draws (with lindstedt.plot) within the figure budget."""
+def test_figure_code_draws(page, number, code):
+    """What the plot directive runs at build time: it draws (with lindstedt.plot); its speed is not a test."""
     matplotlib = pytest.importorskip("matplotlib", reason="the figures need matplotlib: pip install 'lindstedt[plot]'")
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     plt.close("all")
-    started = time.perf_counter()
     exec(compile(code, f"{page}, figure {number}", "exec"), {"__name__": "figure"})  # noqa: S102 - our own pages
-    elapsed = time.perf_counter() - started
     try:
         figures = [plt.figure(n) for n in plt.get_fignums()]
         assert figures and any(ax.has_data() for figure in figures for ax in figure.axes), f"{page} figure {number} draws nothing"
     finally:
         plt.close("all")
-    assert elapsed < FIGURE_BUDGET, f"{page} figure {number} took {elapsed:.1f} s (budget {FIGURE_BUDGET} s)"
 
 
 def test_the_gallery_is_every_notebook_executed():
@@ -93,7 +87,7 @@ def test_the_gallery_is_every_notebook_executed():
     assert {"myst_nb", "matplotlib.sphinxext.plot_directive"} <= set(conf["extensions"])
     # the notebooks are stored without outputs: the build executes them, and a failing cell fails it
     assert conf["nb_execution_mode"] == "force" and conf["nb_execution_raise_on_error"] is True
-    assert 0 < conf["nb_execution_timeout"] <= 300
+    assert conf["nb_execution_timeout"] >= 300  # a hang guard, never a speed budget
 
 
 def test_generated_gallery_copies_are_ignored_by_git():

@@ -15,7 +15,6 @@ from __future__ import annotations
 import json
 import math
 import shutil
-import time
 
 import mpmath
 import numpy as np
@@ -274,12 +273,10 @@ SLOPE_TOLERANCE = 0.15
 
 
 def test_fitted_order_duffing_first_and_second_order():
-    start = time.perf_counter()
     errors = _fitted_errors("u**3", lambda x: x**3, 0.5, 1.0, 0.2, 0, orders=(1, 2))
     assert abs(_slope(errors[1]) - 1) < SLOPE_TOLERANCE, errors
     assert abs(_slope(errors[2]) - 2) < SLOPE_TOLERANCE, errors
     assert all(e2 < e1 for e1, e2 in zip(errors[1], errors[2]))
-    assert time.perf_counter() - start < 30
 
 
 def test_fitted_order_gap_with_contact():

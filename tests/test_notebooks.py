@@ -3,9 +3,10 @@
 Each notebook reproduces a figure of the seed with lindstedt and ends with a
 cell of assertions against independent references, so executing it is a test.
 They run in a fresh ``python3`` kernel (nbclient) with matplotlib's inline
-backend (headless, as in Jupyter), from the ``notebooks/`` directory, each
-within its own time budget.  The executed notebooks must show what a reader
-sees in Jupyter: the figures drawn by ``lindstedt.plot`` (``image/png``
+backend (headless, as in Jupyter), from the ``notebooks/`` directory.  Their
+speed is not a test (a busy machine must not turn the suite red): nbclient's
+per-cell timeout only catches a hang.  The executed notebooks must show what a
+reader sees in Jupyter: the figures drawn by ``lindstedt.plot`` (``image/png``
 outputs) and the results' rich displays (``_repr_latex_`` / ``_repr_html_``).
 
 Needs the ``notebooks`` extra (``pip install -e ".[dev,notebooks]"``).  Without
@@ -17,26 +18,26 @@ from __future__ import annotations
 
 import json
 import os
-import time
 from pathlib import Path
 
 import pytest
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
 
-#: every notebook with its wall-clock budget in seconds (measured: 3–12 s each on 2 cores, kernel start included)
-BUDGETS = {
-    "fig2_spectrum_u_plus.ipynb": 60,
-    "fig3_lp_nnm_5dof.ipynb": 60,
-    "fig4_8_numerical_nnm.ipynb": 60,
-    "validity_time.ipynb": 60,
-    "backbone.ipynb": 60,
-    "runtime_vs_error.ipynb": 60,
-    "hertz_backbone.ipynb": 90,
-    "forced_response.ipynb": 60,
-}
-#: nbclient's limit for one cell
-CELL_TIMEOUT = 120
+#: every notebook of the gallery
+NAMES = (
+    "backbone.ipynb",
+    "fig2_spectrum_u_plus.ipynb",
+    "fig3_lp_nnm_5dof.ipynb",
+    "fig4_8_numerical_nnm.ipynb",
+    "forced_response.ipynb",
+    "hertz_backbone.ipynb",
+    "runtime_vs_error.ipynb",
+    "validity_time.ipynb",
+)
+#: nbclient's limit for one cell: a hang guard, far above normal (a whole notebook takes 3–12 s on an idle 2-core
+#: machine, about 100 s on a loaded one; no cell takes more than a few seconds when idle)
+CELL_TIMEOUT = 600
 #: the matplotlib backend of the kernel: Jupyter's inline backend, so that figures become image/png outputs
 INLINE_BACKEND = "module://matplotlib_inline.backend_inline"
 
@@ -98,10 +99,10 @@ def _code_cells(notebook: dict) -> list[dict]:
 
 
 def test_the_notebook_list_is_complete():
-    assert sorted(path.name for path in NOTEBOOKS.glob("*.ipynb")) == sorted(BUDGETS)
+    assert sorted(path.name for path in NOTEBOOKS.glob("*.ipynb")) == list(NAMES)
 
 
-@pytest.mark.parametrize("name", sorted(BUDGETS))
+@pytest.mark.parametrize("name", NAMES)
 def test_saved_without_outputs(name):
     notebook = _load(name)
     for index, cell in enumerate(_code_cells(notebook)):
@@ -111,15 +112,15 @@ def test_saved_without_outputs(name):
     assert notebook["metadata"]["kernelspec"]["name"] == "python3"
 
 
-@pytest.mark.parametrize("name", sorted(BUDGETS))
+@pytest.mark.parametrize("name", NAMES)
 def test_figures_come_from_the_plotting_api(name):
     sources = "".join("".join(cell["source"]) for cell in _code_cells(_load(name)))
     for function in sorted(PLOT_FUNCTIONS[name]):
         assert f"lindstedt.plot.{function}(" in sources, f"{name}: draw with lindstedt.plot.{function}"
-    assert set(PLOT_FUNCTIONS) == set(BUDGETS) == set(FIGURES)
+    assert set(PLOT_FUNCTIONS) == set(NAMES) == set(FIGURES)
 
 
-@pytest.mark.parametrize("name", sorted(BUDGETS))
+@pytest.mark.parametrize("name", NAMES)
 def test_header_and_final_assertions(name):
     notebook = _load(name)
     first = notebook["cells"][0]
@@ -140,7 +141,7 @@ def _client_modules():
     return nbclient, nbformat
 
 
-@pytest.mark.parametrize("name", sorted(BUDGETS))
+@pytest.mark.parametrize("name", NAMES)
 def test_notebook_executes(name, monkeypatch):
     nbclient, nbformat = _client_modules()
     monkeypatch.setenv("MPLBACKEND", INLINE_BACKEND)
@@ -151,13 +152,10 @@ def test_notebook_executes(name, monkeypatch):
         kernel_name="python3",
         resources={"metadata": {"path": str(NOTEBOOKS)}},
     )
-    started = time.perf_counter()
     try:
         client.execute()
     except nbclient.exceptions.CellExecutionError as error:
         pytest.fail(f"{name} failed:\n{error}")
-    elapsed = time.perf_counter() - started
-    assert elapsed < BUDGETS[name], f"{name} took {elapsed:.1f} s (budget {BUDGETS[name]} s)"
     outputs = [output for cell in notebook.cells if cell.cell_type == "code" for output in cell.outputs]
     # an exception raised while a figure is drawn (after the cell's code ran) does not stop nbclient
     errors = [f"{output.get('ename')}: {output.get('evalue')}" for output in outputs if output.get("output_type") == "error"]
