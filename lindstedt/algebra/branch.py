@@ -30,6 +30,8 @@ from typing import Any, Iterable, Mapping
 import sympy
 from sympy import QQ
 
+from .._precision import LOCK
+
 __all__ = ["Branch", "EvaluationPoint"]
 
 # A term key is (harmonic j >= 0, parity 0 = cos / 1 = sin, power m >= 0); (0, 1, m) never occurs.
@@ -154,18 +156,25 @@ class EvaluationPoint:
         self._powers = [domain.one]
         self._cache: dict[Any, tuple[Any, Any]] = {}
 
+    # The tables only grow, an entry appended complete (cos before sin): a length that covers an index
+    # means its entries are final, so reads need no lock; growing takes it (points are shared by threads).
     def power(self, exponent: int) -> Any:
         """s0 ** exponent."""
-        while len(self._powers) <= exponent:
-            self._powers.append(self._powers[-1] * self.value)
+        if len(self._powers) <= exponent:
+            with LOCK:
+                while len(self._powers) <= exponent:
+                    self._powers.append(self._powers[-1] * self.value)
         return self._powers[exponent]
 
     def _extend(self, harmonic: int) -> None:
-        while len(self._cos) <= harmonic:
-            # cos((j+1)x) = 2 cos x cos jx - cos((j-1)x); same recurrence for sin.
-            two_cos = self._cos[1] + self._cos[1]
-            self._cos.append(two_cos * self._cos[-1] - self._cos[-2])
-            self._sin.append(two_cos * self._sin[-1] - self._sin[-2])
+        if len(self._sin) > harmonic:
+            return
+        with LOCK:
+            while len(self._sin) <= harmonic:
+                # cos((j+1)x) = 2 cos x cos jx - cos((j-1)x); same recurrence for sin.
+                two_cos = self._cos[1] + self._cos[1]
+                self._cos.append(two_cos * self._cos[-1] - self._cos[-2])
+                self._sin.append(two_cos * self._sin[-1] - self._sin[-2])
 
     def cos_multiple(self, harmonic: Any) -> Any:
         """cos(harmonic · s0); a non-integer frequency needs a float domain (RealField)."""

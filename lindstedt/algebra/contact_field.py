@@ -69,7 +69,6 @@ pi - acos(3/10)
 
 from __future__ import annotations
 
-import threading
 from fractions import Fraction
 from typing import Any, Iterable, Sequence
 
@@ -79,6 +78,7 @@ from sympy.polys.orderings import lex
 from sympy.polys.polyerrors import CoercionFailed
 from sympy.polys.rings import PolyElement, PolyRing
 
+from .._precision import LOCK
 from .cosine import power_by_squaring
 
 __all__ = ["ContactElement", "ContactField"]
@@ -93,20 +93,19 @@ _ROOTS: dict[int, sympy.Dummy] = {}
 _RINGS: dict[tuple, PolyRing] = {}
 _FIELDS: dict[tuple, "ContactField"] = {}
 _FIELD_CACHE_SIZE = 64
-_LOCK = threading.RLock()  # the tables above are shared by threads building hierarchies at once
 _SHORT = 12  # numerators of at most this many terms print both ways (σ kept in the denominator or not)
 _TRIAL_LIMIT = 2**15  # radicands are factored by trial division up to this (larger factors: primes or squares)
 
 
 def _generator(table: dict, position: int, name: str) -> sympy.Dummy:
-    with _LOCK:
+    with LOCK:  # the tables are shared by threads building hierarchies at once
         if position not in table:
             table[position] = sympy.Dummy(f"{name}{position}")
         return table[position]
 
 
 def _ring(symbols: tuple) -> PolyRing:
-    with _LOCK:
+    with LOCK:  # the tables are shared by threads building hierarchies at once
         if symbols not in _RINGS:
             _RINGS[symbols] = PolyRing(symbols, QQ, lex)
         return _RINGS[symbols]
@@ -271,7 +270,7 @@ class ContactField:
             atoms[kappa] = field._poly(gens[len(plain) + i])
         for symbol in parameters:
             atoms[symbol] = field._poly(gens[symbols.index(symbol)])
-        with _LOCK:
+        with LOCK:  # the tables are shared by threads building hierarchies at once
             _FIELDS[key] = field
             while len(_FIELDS) > _FIELD_CACHE_SIZE:  # oldest first (dicts keep insertion order)
                 del _FIELDS[next(iter(_FIELDS))]

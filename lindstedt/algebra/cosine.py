@@ -27,6 +27,7 @@ import sympy
 from sympy import Rational
 
 from .._errors import LindstedtError
+from .._precision import workprec
 
 # Series at least this long multiply through one integer product (_doubled_product_sum) rather than the
 # pairwise loop: the crossover measured here is near 8 terms for gmpy rationals and 32 for mpf floats.
@@ -231,7 +232,7 @@ class CosineSeries(_TrigonometricSeries):
         (first, first_exponent), (second, second_exponent) = integers(self), integers(other)
         exponent = first_exponent + second_exponent - 1  # the 1/2 of the product-to-sum rule
         dtype = self.domain.dtype
-        with mpmath.workprec(self.domain.precision):  # the one rounding, to the domain's precision
+        with workprec(self.domain.precision):  # the one rounding, to the domain's precision
             result = {n: dtype(mpmath.mpf((total, exponent))) for n, total in _doubled_product_sum([(first, second, 1)]).items()}
         return CosineSeries(self.domain, result)
 

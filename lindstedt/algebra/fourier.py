@@ -44,6 +44,7 @@ import sympy
 
 from .._errors import ProblemError
 from ..problems.parsing import parse_real
+from .._precision import workdps
 
 __all__ = [
     "KappaLike",
@@ -392,7 +393,7 @@ def _coefficient_mp(k: int, kappa: KappaLike, precision: int, ramp: bool) -> mpm
     if not isinstance(precision, int) or isinstance(precision, bool) or precision < 1:
         raise ProblemError(f"precision={precision!r} must be a positive int number of decimal digits")
     harmonic = _as_harmonic(k)
-    with mpmath.workdps(precision + 10):
+    with workdps(precision + 10):
         sign, magnitude, gap = _exact_kappa_parts(kappa)
         if gap <= 0:  # |kappa| >= 1
             if sign > 0:
@@ -403,7 +404,7 @@ def _coefficient_mp(k: int, kappa: KappaLike, precision: int, ramp: bool) -> mpm
         angle_estimate = 2 * mpmath.asin(mpmath.sqrt(gap / 2))
         phase_estimate = angle_estimate * max(harmonic, 1)
         lost_digits = 0 if phase_estimate >= 1 else int(-2 * mpmath.log10(phase_estimate)) + 1
-    with mpmath.workdps(precision + 15 + lost_digits):
+    with workdps(precision + 15 + lost_digits):
         sign, magnitude, gap = _exact_kappa_parts(kappa)
         angle = 2 * mpmath.asin(mpmath.sqrt(gap / 2))
         sine_of_angle = mpmath.sqrt(gap * (1 + magnitude))
@@ -425,7 +426,7 @@ def _coefficient_mp(k: int, kappa: KappaLike, precision: int, ramp: bool) -> mpm
             value = angle / pi if harmonic == 0 else 2 * mpmath.sin(harmonic * angle) / (pi * harmonic)
             if sign < 0:
                 value = 1 - value if harmonic == 0 else -((-1) ** harmonic) * value
-    with mpmath.workdps(precision):
+    with workdps(precision):
         return +value
 
 

@@ -20,6 +20,7 @@ import sympy
 
 from .._errors import ConvergenceError, ProblemError
 from .fourier import _as_harmonic
+from .._precision import workdps
 
 __all__ = ["SeriesEstimate", "series_sum", "sum_cosine_series_at"]
 
@@ -186,7 +187,7 @@ def _series_core(
     def run(digits: int) -> tuple[mpmath.mpf, bool, mpmath.mpf, _Blocks]:
         # nsum at `digits`; when its stopping rule is not met, twice the spread of its
         # values from fewer terms (same cached blocks) is the error estimate
-        with mpmath.workdps(digits):
+        with workdps(digits):
             blocks = _Blocks(term, start_index, block, mpmath.mpf(10) ** -(precision + 3))
             budget = blocks.budget(maxterms)
             value, converged = blocks.nsum(budget, method)
@@ -201,9 +202,9 @@ def _series_core(
     if converged:  # confirm with 10 more digits: nsum then has to agree to a 10**10 finer tolerance
         first = value
         value, converged, spread, blocks = run(precision + _EXTRA_DIGITS)
-        with mpmath.workdps(precision + _EXTRA_DIGITS):
+        with workdps(precision + _EXTRA_DIGITS):
             error = max(abs(value - first), spread)
-    with mpmath.workdps(precision):
+    with workdps(precision):
         target = mpmath.mpf(10) ** (-(precision // 2)) if tolerance is None else mpmath.mpf(tolerance)
         error = max(error, mpmath.mpf(10) ** (-precision) * max(abs(value), 1))
         if not mpmath.isfinite(error) or error > target:

@@ -24,6 +24,7 @@ import sympy
 from ..methods.lindstedt_poincare import expand
 from ..references.duffing import duffing_frequency_taylor
 from ..references.piecewise import piecewise_linear_frequency_taylor, piecewise_linear_frequency_taylor_symbolic
+from .._precision import workdps
 
 __all__ = ["run_demo"]
 
@@ -94,7 +95,7 @@ def run_demo(order: int = 8, figure_path: str | None = None) -> str:
     elapsed = time.perf_counter() - tick
     lines.append(f"   derived in {elapsed * 1e3:.0f} ms; contact angle beta = {gap.contact_angles[0]}")
     lines.append(f"     omega_1 = {sympy.simplify(gap_omegas[1])}")
-    with mpmath.workdps(40):
+    with workdps(40):
         reference_values = piecewise_linear_frequency_taylor(4, a=1, b=mpmath.mpf(1) / 3, a0=1, precision=40)
         worst = 0.0
         for k in range(1, 5):

@@ -61,6 +61,7 @@ import numpy as np
 
 from .._errors import ResonanceError
 from ..algebra.branch import Branch, EvaluationPoint
+from .._precision import locked
 from .orders import LazyOrders, shift_powers
 from .stretched import FloatArc
 
@@ -364,27 +365,32 @@ class BranchHierarchy(LazyOrders):
         self._projection_cache: dict[tuple[int, int], list[Branch]] = {}
 
     # -- read access ---------------------------------------------------------------------------------
+    @locked
     def branches(self, order: int) -> list[list[Branch]]:
         """W_order: ``branches(order)[piece][component]``."""
         self._ensure(order)
         self._complete(order)
         return self._branches[order]
 
+    @locked
     def boundary_shift(self, order: int) -> list[Any]:
         """σ_{i,order} for every boundary (order 0: the contact angles β_i)."""
         self._ensure(order + self._lag)
         self._complete(order + self._lag)
         return [shifts[order] for shifts in self._shifts]
 
+    @locked
     def release(self, order: int, component: int) -> Any:
         """W_{order, component}(0)."""
         return self.branches(order)[0][component].evaluate(self.system.zero_point)
 
+    @locked
     def arc_length(self, which: int, order: int) -> Any:
         """ℓ_order of stretched arc ``which`` (0: first piece, ℓ = s_1*; 1: last piece, ℓ = π − s_L*)."""
         self._ensure(order)
         return self._arc_data[which]["length"][order]
 
+    @locked
     def float_branches(self, highest: int, to_float: Any = float) -> FloatBranches:
         """:class:`FloatBranches` of W_0 … W_highest, coefficients converted by ``to_float``."""
         terms = tuple(

@@ -43,6 +43,7 @@ from ..algebra.branch import EvaluationPoint
 from ..algebra.contact_field import ContactField
 from .branches import BranchHierarchy, BranchSystem, ContactState, MovingBoundary
 from .stretched import StretchedArc
+from .._precision import locked, workdps
 
 __all__ = ["ContactBoundary", "PiecewiseNormalForm", "contact_normal_form"]
 
@@ -198,7 +199,7 @@ def _guard_digits(kappas: list[sympy.Expr], order: int) -> int:
     (2k + 3)·log10(1/m) digits cancel; they are added to the working precision.
     """
     margin = mpmath.mpf(1)
-    with mpmath.workdps(50):
+    with workdps(50):
         for kappa in kappas:
             if not kappa.is_number:
                 continue
@@ -209,6 +210,7 @@ def _guard_digits(kappas: list[sympy.Expr], order: int) -> int:
         return int(mpmath.ceil((2 * order + 5) * max(0, -mpmath.log10(margin))))
 
 
+@locked
 def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hint: int = 4) -> PiecewiseNormalForm:
     """Build the normalised piecewise problem.
 
@@ -325,7 +327,7 @@ def _stretched_arcs(problem: Oscillator, w_intervals: list, interval_of: list[in
     def number(value: sympy.Expr) -> mpmath.mpf:
         if not value.is_number:
             raise UnsupportedNonlinearityError(f"f = {problem.f}: {supported} (got the symbolic {value})")
-        with mpmath.workdps(digits):
+        with workdps(digits):
             return mpmath.mpf(sympy.N(value, digits))
 
     arcs = []

@@ -37,6 +37,7 @@ import sympy
 from sympy import RealField
 
 from .._errors import ProblemError, ResonanceError
+from .._precision import locked
 from ..problems.system import UnilateralSystem
 from ..algebra.branch import EvaluationPoint
 from .branches import BranchHierarchy, BranchSystem, ContactState, MovingBoundary
@@ -75,6 +76,7 @@ class ModalNormalForm:
     small_divisors: tuple[tuple[int, int, Any], ...]  # (k, nearest harmonic n, |r_k² − n²|), 0-based k
 
 
+@locked
 def modal_guard_digits(system: UnilateralSystem, mode: int, order: int) -> int:
     """Extra digits near an internal resonance: each order divides by |r_k² − n²| once more (mode 0-based)."""
     frequencies = system.modes().frequencies
@@ -130,6 +132,7 @@ def _classify(index: int, coupling: Any, gap: Any, digits: int, mode: int) -> Sp
     return SpringAtOrderZero(index, coupling, kappa, orientation, status)
 
 
+@locked
 def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, release_correction: Any, digits: int) -> ModalNormalForm:
     """The modal normal form of the NNM of ``mode`` (0-based) released at u_j(0) = a0 + ε a1, in ``digits`` digits."""
     domain = RealField(dps=digits)

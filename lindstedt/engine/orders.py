@@ -10,6 +10,8 @@ from typing import Any, Callable
 
 from sympy import Rational
 
+from .._precision import locked
+
 __all__ = ["LazyOrders", "extend_square_root", "shift_powers"]
 
 
@@ -55,7 +57,10 @@ class LazyOrders:
     """Mixin for hierarchies solved order by order on demand.
 
     The host defines ``_solve_order(n)`` (which appends A_n to ``_squared``),
-    ``_squared = [1]``, ``_frequencies = [1]`` and ``_domain``.
+    ``_squared = [1]``, ``_frequencies = [1]`` and ``_domain``.  A hierarchy is shared by every
+    expansion of its problem (the process-wide cache), so every method that may grow it holds
+    :data:`lindstedt._precision.LOCK` (:func:`~lindstedt._precision.locked`): two threads never
+    solve the same order at once.
     """
 
     _squared: list[Any]
@@ -66,11 +71,13 @@ class LazyOrders:
         while len(self._squared) <= order:
             self._solve_order(len(self._squared))  # type: ignore[attr-defined]  # defined by the host class
 
+    @locked
     def squared_frequency(self, order: int) -> Any:
         """A_order: coefficient of ε̂^order in Ω² (Ω = ω/ω_0)."""
         self._ensure(order)
         return self._squared[order]
 
+    @locked
     def frequency(self, order: int) -> Any:
         """Ω_order: coefficient of ε̂^order in Ω = sqrt(Σ A_k ε̂^k)."""
         return extend_square_root(self._frequencies, self.squared_frequency, order, self._domain)

@@ -60,6 +60,7 @@ from .._errors import UnsupportedNonlinearityError
 from ..problems.oscillator import DISPLACEMENT, Oscillator
 from .branches import FloatBranches
 from .orders import LazyOrders
+from .._precision import locked, workdps
 
 __all__ = ["MAX_ORDER", "NormalForm", "SmoothHierarchy", "normal_form"]
 
@@ -375,6 +376,7 @@ class _ChebyshevTaylor:
         value = complex(sympy.N(self._problem.a0)) * point
         return f"{value.real:.6g}" if abs(value.imag) < 1e-12 * max(abs(value), 1) else f"{value:.6g}"
 
+    @locked
     def coefficients(self, order: int) -> list[mpmath.mpf]:
         """Chebyshev coefficients of ``g_order`` (at the working precision)."""
         if order > self._highest:
@@ -389,7 +391,7 @@ class _ChebyshevTaylor:
             if nodes > _MAX_CHEBYSHEV_NODES:
                 break
             working = wanted + math.ceil(2 * highest * math.log10(nodes)) + 10  # the recurrence amplifies rounding ~N^(2m)
-            with mpmath.workdps(working):
+            with workdps(working):
                 coefficients = self._transform(nodes, working)
                 needed = self._nodes_from_decay(coefficients, rho, wanted, highest, working)
                 if needed <= nodes:
@@ -397,7 +399,7 @@ class _ChebyshevTaylor:
                     for m in range(1, highest + 1):
                         series.append(_chebyshev_derivative(series[-1], m))
                     if self._matches_off_grid(series, working):
-                        with mpmath.workdps(self._digits + _GUARD_DIGITS + 5):
+                        with workdps(self._digits + _GUARD_DIGITS + 5):
                             self._series = [[+c for c in s] for s in series]
                         self._highest = highest
                         return
@@ -419,7 +421,7 @@ class _ChebyshevTaylor:
         sampling = working + self._cancelled_digits(working)
         for j in range(nodes):
             try:
-                with mpmath.workdps(sampling):
+                with workdps(sampling):
                     value = +mpmath.mpf(self._function(mpmath.cospi(mpmath.mpf(2 * j + 1) / (2 * nodes))))
             except (ZeroDivisionError, ValueError, TypeError) as error:
                 raise UnsupportedNonlinearityError(
@@ -465,7 +467,7 @@ class _ChebyshevTaylor:
         return self._cancellation[working]
 
     def _value_at(self, point: str, digits: int) -> mpmath.mpf:
-        with mpmath.workdps(digits):
+        with workdps(digits):
             try:
                 return mpmath.mpf(self._function(mpmath.mpf(point)))
             except (ZeroDivisionError, ValueError, TypeError) as error:
@@ -499,7 +501,7 @@ class _ChebyshevTaylor:
         tolerance = mpmath.mpf(10) ** (-(self._digits + 2))
         size = max(abs(c) for c in series[0])  # g_m far below f̂ need only be accurate relative to f̂
         for point in (mpmath.mpf(-1), *(mpmath.mpf(probe) for probe in _PROBES)):
-            with mpmath.workdps(working + self._cancelled_digits(working)):
+            with workdps(working + self._cancelled_digits(working)):
                 try:
                     derivatives = mpmath.taylor(self._function, point, len(series) - 1)
                 except (ZeroDivisionError, ValueError, TypeError):  # f̂ not analytic around the point: refine, then fail
@@ -529,6 +531,7 @@ def _clenshaw(coefficients: list, point: Any) -> Any:
     return point * current - following + coefficients[0]
 
 
+@locked
 def normal_form(problem: Oscillator, digits: int = 30) -> NormalForm:
     """Build the normalised hierarchy data for a smooth problem.
 
@@ -580,6 +583,7 @@ class SmoothHierarchy(LazyOrders):
         self.counters["products"] += len(pairs)
         return self._prune(sum_of_products(pairs, self._domain))
 
+    @locked
     def delta_power(self, power: int, order: int) -> CosineSeries:
         """ε̂^order coefficient of δ^power, δ = Σ_{j≥1} ε̂^j w_j."""
         key = (power, order)
@@ -614,12 +618,14 @@ class SmoothHierarchy(LazyOrders):
                 yield series, self.delta_power(power, order)
             power += 1
 
+    @locked
     def forcing(self, order: int) -> CosineSeries:
         """``F_order``: the ε̂^order coefficient of f̂(w) as a cosine series."""
         if order not in self._forcing:
             self._forcing[order] = self._sum_of_products(list(self._taylor_terms(order)))
         return self._forcing[order]
 
+    @locked
     def forcing_secular(self, order: int) -> Any:
         """``[F_order]_1`` without forming F_order when it is not cached."""
         if order in self._forcing:
@@ -639,6 +645,7 @@ class SmoothHierarchy(LazyOrders):
             value = value - self._squared[i] * self.waveform(k - i).coefficient(1)
         self._squared.append(value)
 
+    @locked
     def float_branches(self, highest: int, to_float: Callable[[Any], float] = float) -> FloatBranches:
         """w_0 … w_highest as one float branch each (one piece, no contact boundary)."""
         terms = tuple(
@@ -647,6 +654,7 @@ class SmoothHierarchy(LazyOrders):
         )
         return FloatBranches(terms, ((),) * (highest + 1))
 
+    @locked
     def waveform(self, order: int) -> CosineSeries:
         """``w_order`` (normalised correction of order ``order``)."""
         while len(self._waveforms) <= order:

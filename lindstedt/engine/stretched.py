@@ -58,6 +58,7 @@ import numpy as np
 import sympy
 
 from .._errors import ConvergenceError, UnsupportedNonlinearityError
+from .._precision import locked, workdps
 
 __all__ = ["StretchedArc", "FloatArc"]
 
@@ -119,7 +120,7 @@ class StretchedArc:
         self._working = digits + _GUARD_DIGITS
         self._turning: list[Any] = [mpmath.mpf(1)]  # h_n = Y_n(0) as fixed so far
         self._pending: tuple[int, dict] | None = None
-        with mpmath.workdps(self._working):
+        with workdps(self._working):
             self.kappa = mpmath.mpf(kappa)
             self.coefficient = mpmath.mpf(coefficient) if exponent is not None else mpmath.mpf(0)
             self.beta = mpmath.acos(self.kappa)
@@ -130,7 +131,7 @@ class StretchedArc:
     # -- grid -------------------------------------------------------------------------------------------
     def _reset(self) -> None:
         M, d = self.nodes, self.denominator
-        with mpmath.workdps(self._working):
+        with workdps(self._working):
             angles = [mpmath.pi * (i + mpmath.mpf(1) / 2) / M for i in range(M)]
             x = [mpmath.cos(angle) for angle in angles]
             self._x = x
@@ -295,9 +296,10 @@ class StretchedArc:
         self.counters["restarts"] += 1
         self._reset()
         for n in range(1, order):
-            with mpmath.workdps(self._working):
+            with workdps(self._working):
                 self._solve(n, self._turning[n], self._particular(n))
 
+    @locked
     def response(self, order: int) -> tuple[Any, Any, Any, Any]:
         """``(μ_c, μ_h, S_c, S_h)`` with μ_order = μ_c + μ_h h and Y_order'(1) = S_c + S_h h, h = Y_order(0).
 
@@ -308,37 +310,41 @@ class StretchedArc:
             raise ValueError(f"order {order} of the stretched arc is not the next one ({len(self._mu)})")
         tolerance = mpmath.mpf(10) ** (-(self.digits + 2))
         while True:
-            with mpmath.workdps(self._working):
+            with workdps(self._working):
                 data = self._particular(order)
             if max(data["tail"], self.tail) <= tolerance:
                 break
             self._refine(order)
         self._pending = (order, data)
-        with mpmath.workdps(self._working):
+        with workdps(self._working):
             return self._response(data)
 
+    @locked
     def fix(self, order: int, turning_value: Any) -> None:
         """Complete Y_order with its turning-point value h = Y_order(0)."""
         if self._pending is None or self._pending[0] != order:
             self.response(order)
-        with mpmath.workdps(self._working):
+        with workdps(self._working):
             value = mpmath.mpf(turning_value)
             self._solve(order, value, self._pending[1])
         self._turning.append(value)
         self._pending = None
         self.counters["orders"] += 1
 
+    @locked
     def series(self, order: int) -> tuple[list[Any], list[Any]]:
         """Chebyshev coefficients (in x = 2v − 1) of Y_order and of dY_order/dτ (fixed orders only)."""
         if order == 0:
-            with mpmath.workdps(self._working):
+            with workdps(self._working):
                 return self._coefficients(self._cos), self._coefficients([-self.beta * s for s in self._sin])
         return self._series[order - 1]
 
+    @locked
     def mu(self, order: int) -> Any:
         """μ_order (fixed orders only)."""
         return self._mu[order]
 
+    @locked
     def slope(self, order: int) -> Any:
         """Y_order'(1) (fixed orders only)."""
         return self._slope[order]
@@ -347,6 +353,7 @@ class StretchedArc:
         if len(self._mu) <= order:
             raise ValueError(f"order {order} of the stretched arc is not fixed yet")
 
+    @locked
     def float_arc(self, highest: int) -> FloatArc:
         """The float evaluator of Y_0 … Y_highest."""
         self._ensure(highest)

@@ -58,6 +58,7 @@ from sympy.printing.c import C99CodePrinter
 from sympy.printing.numpy import NumPyPrinter
 
 from .._errors import CodeGenerationError, ProblemError
+from .._precision import locked
 from ._names import _PYTHON_RESERVED, _safe_names
 from ._targets import _TARGETS, _renaming, _stable_target_source, _target_source, _wrapped
 from .stable import SERIES_TARGET, Patch, StableCoefficient, stable_coefficient
@@ -605,6 +606,7 @@ def _build(compiler: str, source: str, stem: str) -> None:
     _write_atomically(stem + ".so.sha256", f"{digest}\n".encode())
 
 
+@locked  # one build at a time: a thread checking a library another one is writing would delete it
 def _compile_c(code: GeneratedCode) -> Callable[..., np.ndarray]:
     """Build (or reuse) the shared library of ``code`` and wrap its function.
 

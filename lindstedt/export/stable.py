@@ -19,6 +19,8 @@ import numpy as np
 import sympy
 from gmpy2 import mpq as Fraction  # exact rationals, several times faster than fractions.Fraction
 
+from .._precision import locked, workdps
+
 __all__ = ["SERIES_TARGET", "BoundedFamily", "Patch", "StableCoefficient", "compile_family", "stable_coefficient"]
 
 # Stable evaluation of ω_k(κ) for a gap: piecewise series near κ = ±1 (and at interior roots)
@@ -222,17 +224,18 @@ def _mp_value(term: dict[int, Fraction]) -> Any:
     return mpmath.fsum(mpmath.mpf(v.numerator) / v.denominator * mpmath.pi**m for m, v in term.items())
 
 
+@locked
 def stable_coefficient(expression: sympy.Expr, x: sympy.Symbol) -> StableCoefficient | None:
     """The piecewise-series form of ω_k(x) (see the comment above), or None if ``expression`` has another shape."""
 
     parts = _gap_parts(expression, x)
     if parts is None:
         return None
-    with mpmath.workdps(60):
+    with workdps(60):
         closed = sympy.lambdify(x, expression, "mpmath")
 
         def exact(kappa: Any) -> Any:  # the closed form at 120 digits (it cancels at most ~40 digits at the samples)
-            with mpmath.workdps(2 * 60):
+            with workdps(2 * 60):
                 return +closed(mpmath.mpf(kappa))
 
         edge, other_edge = mpmath.mpf(_BETA_SWITCH), mpmath.mpf(_GAMMA_SWITCH)
@@ -693,7 +696,7 @@ class _FamilyBuilder:
                 raise _Unsupported(f"the constant {expression} is not a finite real number")
             dummy = sympy.Dummy("c")
             self.constant_keys[expression] = dummy
-            with mpmath.workdps(45):
+            with workdps(45):
                 self.constants[dummy] = mpmath.mpf(value)
         return self.constant_keys[expression]
 
@@ -761,7 +764,7 @@ class _FamilyBuilder:
 
     def fold(self, expression: sympy.Expr) -> Any:
         """A symbol-free expression in the constant dummies, at 45 digits."""
-        with mpmath.workdps(45):
+        with workdps(45):
             return sympy.lambdify(list(self.constants), expression, "mpmath")(*self.constants.values()) if expression.free_symbols else mpmath.mpf(sympy.N(expression, 45))
 
     def rows_of(self, polynomial: sympy.Expr, generators: list[sympy.Symbol]) -> dict[tuple[int, ...], Any]:
@@ -770,7 +773,7 @@ class _FamilyBuilder:
         poly = sympy.Poly(polynomial, *generators, *constants, domain="QQ")
         width = len(generators)
         terms: dict[tuple[int, ...], Any] = {}
-        with mpmath.workdps(45):
+        with workdps(45):
             for monomial, coefficient in poly.terms():
                 value = mpmath.mpf(int(coefficient.numerator)) / int(coefficient.denominator)
                 for dummy, exponent in zip(constants, monomial[width:]):
@@ -781,6 +784,7 @@ class _FamilyBuilder:
         return {key: value for key, value in terms.items() if value != 0} or {(0,) * width: mpmath.mpf(0)}
 
 
+@locked
 def compile_family(expressions: list[sympy.Expr], symbols: tuple[sympy.Symbol, ...]) -> BoundedFamily | None:
     """A :class:`BoundedFamily` for ``expressions`` in ``symbols``, or None if one of them is outside the
     representation (see the comment block above: polynomials over monomial or polynomial denominators in the
@@ -802,7 +806,7 @@ def compile_family(expressions: list[sympy.Expr], symbols: tuple[sympy.Symbol, .
             bottom = builder.rows_of(denominator, generators)
             if len(bottom) == 1:
                 (shift, divisor), = bottom.items()
-                with mpmath.workdps(45):
+                with workdps(45):
                     top = {tuple(a - b for a, b in zip(key, shift)): value / divisor for key, value in top.items()}
                 links.append(-1)
             else:

@@ -19,6 +19,7 @@ import numpy as np
 import sympy
 
 from .._errors import ProblemError
+from .._precision import locked
 from ..engine.branches import BranchHierarchy
 from ..engine.modal import modal_guard_digits, modal_normal_form
 from ..problems.nnm import NNMProblem
@@ -80,6 +81,7 @@ class StrainedCoordinatesNNM:
         )
 
 
+@locked
 def release_amplitudes_by_series(system: UnilateralSystem, mode: int, a0: Any, *, precision: int = 30) -> list[tuple[Any, Any]]:
     """The a_k (k ≠ j) of Corollary 4.2 as Fourier series, summed by mpmath with an error estimate.
 

@@ -41,12 +41,12 @@ from __future__ import annotations
 import copy
 import keyword
 import math
-import threading
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 import sympy
 
+from .._precision import LOCK
 from .._errors import ParameterError, ProblemError, UnsupportedNonlinearityError
 from .parsing import ALLOWED_FUNCTIONS, CONSTANTS, as_exact, parse_expression, parse_real, parse_value
 from .piecewise_linear import decompose_piecewise
@@ -141,7 +141,7 @@ class _TurningPoint:
     """The positive turning point A(ε) = Σ ε^n A_n of the orbit through (u0, v0), exactly and lazily.
 
     Reversion of the energy equation A² + (2ε/ω0²) F(A) = u0² + v0²/ω0² + (2ε/ω0²) F(u0)
-    (see the module docstring); thread safe (one lock per problem), shared by the copies
+    (see the module docstring); thread safe (grown under :data:`lindstedt._precision.LOCK`), shared by the copies
     of :meth:`Oscillator.with_release_order`.
 
     For polynomial and piecewise-polynomial f with an irrational A0 = R^{1/2} the arithmetic runs in
@@ -161,24 +161,14 @@ class _TurningPoint:
         self._a = sympy.Dummy("A0", positive=True) if algebraic and not problem.a0.is_Rational else None
         self._internal: list[sympy.Expr] = [self._a if self._a is not None else problem.a0]
         self._series: list[sympy.Expr] = [problem.a0]
-        self._lock = threading.Lock()
         self._prepared = False
         self._difference: sympy.Expr = sympy.Integer(0)  # F(A0) − F(u0)
         self._laws: dict[int, sympy.Expr] = {}  # side (+1 above, −1 below, 0 inside a piece) -> f on that piece
         self._side: int | None = None  # the side of A0 the turning point is on (breakpoint only)
         self._derivatives: dict[tuple[int, int], sympy.Expr] = {}
 
-    def __getstate__(self) -> dict[str, Any]:  # picklable (and deep-copyable): the lock is not state
-        state = self.__dict__.copy()
-        del state["_lock"]
-        return state
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        self.__dict__.update(state)
-        self._lock = threading.Lock()
-
     def series(self, order: int) -> tuple[sympy.Expr, ...]:
-        with self._lock:
+        with LOCK:  # shared by the copies and by threads
             if not self._prepared:
                 self._prepare()
             while len(self._series) <= order:

@@ -32,6 +32,7 @@ import sympy
 
 from .._errors import ProblemError
 from .parsing import parse_real
+from .._precision import locked, workdps, workprec
 
 __all__ = ["UnilateralSystem", "Modes", "OneDofUnilateral"]
 
@@ -473,6 +474,7 @@ class UnilateralSystem:
         shapes.setflags(write=False)
         return Modes(frequencies, shapes)
 
+    @locked
     def modes_high_precision(self, digits: int) -> tuple[list[Any], list[list[Any]]]:
         """The modes of :meth:`modes` computed from the exact matrices to ``digits`` digits.
 
@@ -498,13 +500,14 @@ class UnilateralSystem:
         refined = _refined_modes(self, digits)
         if refined is None:
             return _dense_mpmath_modes(self, digits)
-        with mpmath.workprec(refined.bits):
+        with workprec(refined.bits):
             frequencies = refined.frequencies()
             roots = [mpmath.sqrt(norm) for norm in refined.norms]
             shapes = [[mpmath.mpf(int(value)) / root for value in refined.X[:, k]] for k, root in enumerate(roots)]
-        with mpmath.workdps(digits):
+        with workdps(digits):
             return [+value for value in frequencies], [[+value for value in column] for column in shapes]
 
+    @locked
     def modal_coupling(self, digits: int) -> tuple[list[Any], list[list[Any]], list[list[Any]]]:
         """λ_k, ``B = A Φ`` (m×N) and ``G = Φᵀ W`` (N×m) to ``digits`` digits: all the modal normal form needs.
 
@@ -536,18 +539,18 @@ class UnilateralSystem:
         refined = _refined_modes(self, digits)
         if refined is None:
             frequencies, columns = _dense_mpmath_modes(self, digits)
-            with mpmath.workdps(digits + 10):
+            with workdps(digits + 10):
                 A = [[_exact_mpf(v) for v in row] for row in self.A_exact.tolist()]
                 W = [[_exact_mpf(v) for v in row] for row in self.W_exact.tolist()]
                 B = [[+mpmath.fdot(row, column) for column in columns] for row in A]
                 G = [[+mpmath.fdot(column, (W[r][i] for r in range(self.n_dof))) for i in range(self.n_springs)] for column in columns]
-            with mpmath.workdps(digits):
+            with workdps(digits):
                 return frequencies, [[+v for v in row] for row in B], [[+v for v in row] for row in G]
-        with mpmath.workprec(refined.bits):
+        with workprec(refined.bits):
             frequencies = refined.frequencies()
             B = refined.projections(self.A_exact)
             G = [list(column) for column in zip(*refined.projections(self.W_exact.T))] if self.n_springs else [[] for _ in range(self.n_dof)]
-        with mpmath.workdps(digits):
+        with workdps(digits):
             return [+value for value in frequencies], [[+value for value in row] for row in B], [[+value for value in row] for row in G]
 
     def modes(self) -> Modes:
@@ -660,7 +663,7 @@ def _fixed_point(value: sympy.Expr, shift: int) -> int:
     if value.is_Rational:
         numerator, denominator = int(value.p) << shift, int(value.q)
         return (2 * numerator + denominator) // (2 * denominator)
-    with mpmath.workprec(shift + 64):
+    with workprec(shift + 64):
         return int(mpmath.nint(mpmath.ldexp(_exact_mpf(value), shift)))
 
 
@@ -829,7 +832,7 @@ def _to_fixed(values: np.ndarray, p: int) -> np.ndarray:
 
 def _dense_mpmath_modes(system: "UnilateralSystem", digits: int) -> tuple[list[Any], list[list[Any]]]:
     """Dense mpmath decomposition (O(N³) in multiprecision): the fallback for near-repeated frequencies."""
-    with mpmath.workdps(digits + 10):
+    with workdps(digits + 10):
         mass = mpmath.matrix([[_exact_mpf(v) for v in row] for row in system.M_exact.tolist()])
         stiffness = mpmath.matrix([[_exact_mpf(v) for v in row] for row in system.K_exact.tolist()])
         inverse_lower = mpmath.inverse(mpmath.cholesky(mass))
@@ -844,7 +847,7 @@ def _dense_mpmath_modes(system: "UnilateralSystem", digits: int) -> tuple[list[A
             sign = 1 if sum(float(value) * reference[row, position] for row, value in enumerate(column)) >= 0 else -1
             frequencies.append(mpmath.sqrt(eigenvalues[index]))
             shapes.append([sign * value for value in column])
-    with mpmath.workdps(digits):
+    with workdps(digits):
         return [+value for value in frequencies], [[+value for value in column] for column in shapes]
 
 

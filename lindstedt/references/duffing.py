@@ -76,6 +76,7 @@ from sympy.polys.rings import ring
 
 from .._errors import ConvergenceError, ProblemError
 from .quadrature import omega0_parameter, real_parameter, validate_precision, validate_order
+from .._precision import locked, workdps
 
 __all__ = ["duffing_exact_frequency", "duffing_frequency_taylor"]
 
@@ -216,6 +217,7 @@ def _strength_from_harmonic(
     return pair(log_gap)
 
 
+@locked
 def duffing_exact_frequency(
     epsilon: Any,
     *,
@@ -268,7 +270,7 @@ def duffing_exact_frequency(
     """
     normalization = _check_normalization(normalization)
     precision = validate_precision(precision)
-    with mpmath.workdps(precision + 10):
+    with workdps(precision + 10):
         epsilon_value = real_parameter(epsilon, "epsilon")
         amplitude_value = real_parameter(amplitude, "amplitude")
         omega0_value = omega0_parameter(omega0)
@@ -279,7 +281,7 @@ def duffing_exact_frequency(
         else:
             x, one_plus_x = _strength_pair(strength, abs(amplitude_value), omega0_value)
         frequency = _frequency(x, one_plus_x, omega0_value)
-    with mpmath.workdps(precision):
+    with workdps(precision):
         return +frequency
 
 
@@ -363,6 +365,7 @@ def _harmonic_taylor(order: int) -> tuple[sympy.Rational, ...]:
     return _coefficients(frequency, order)
 
 
+@locked
 def duffing_frequency_taylor(order: int, normalization: str = "initial") -> list[sympy.Rational]:
     """Exact Taylor coefficients of the Duffing frequency in the strength x.
 

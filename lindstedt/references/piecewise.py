@@ -59,6 +59,7 @@ import mpmath
 import sympy
 
 from .._errors import ConvergenceError, ProblemError
+from .._precision import locked, workdps
 from .quadrature import (
     as_mpmath_number,
     omega0_parameter,
@@ -188,6 +189,7 @@ class _AnalyticBranch:
         return 2 * (mpmath.pi - mpmath.acos(free_argument)) / omega0 + 2 * mpmath.acos(contact_argument) / contact_frequency
 
 
+@locked
 def piecewise_linear_exact_period(
     epsilon: Any,
     *,
@@ -237,7 +239,7 @@ def piecewise_linear_exact_period(
     '6.28318530717959'
     """
     precision = validate_precision(precision)
-    with mpmath.workdps(precision + 10):
+    with workdps(precision + 10):
         a_value, b_value, a0_value, omega0_value = _parameters(a, b, a0, omega0)
         epsilon_value = as_mpmath_number(epsilon, "epsilon")
         if isinstance(epsilon_value, mpmath.mpc) and epsilon_value.imag == 0:
@@ -255,10 +257,11 @@ def piecewise_linear_exact_period(
             period = branch.period(epsilon_value)
         else:
             period = _real_period(epsilon_value * a_value, b_value, a0_value, omega0_value)
-    with mpmath.workdps(precision):
+    with workdps(precision):
         return +period
 
 
+@locked
 def piecewise_linear_exact_frequency(
     epsilon: Any,
     *,
@@ -279,13 +282,14 @@ def piecewise_linear_exact_frequency(
     '1.33333333333333'
     """
     precision = validate_precision(precision)
-    with mpmath.workdps(precision + 10):
+    with workdps(precision + 10):
         period = piecewise_linear_exact_period(epsilon, a=a, b=b, a0=a0, omega0=omega0, precision=precision + 10)
         frequency = 2 * mpmath.pi / period
-    with mpmath.workdps(precision):
+    with workdps(precision):
         return +frequency
 
 
+@locked
 def piecewise_linear_frequency_taylor(
     order: int,
     *,
@@ -339,7 +343,7 @@ def piecewise_linear_frequency_taylor(
     order = validate_order(order, maximum=_MAXIMUM_TAYLOR_ORDER)
     precision = validate_precision(precision)
     working_dps = precision + 15
-    with mpmath.workdps(working_dps):
+    with workdps(working_dps):
         a_value, b_value, a0_value, omega0_value = _parameters(a, b, a0, omega0)
         branch = _AnalyticBranch(a_value, b_value, a0_value, omega0_value)
         zero = mpmath.mpf(0)
@@ -402,6 +406,7 @@ def _cauchy_coefficients(branch: _AnalyticBranch, order: int, working_dps: int) 
     )
 
 
+@locked
 def piecewise_linear_frequency_taylor_symbolic(
     order: int,
     *,

@@ -87,6 +87,7 @@ from .._errors import (
     UnsupportedNonlinearityError,
 )
 from ..problems.parsing import parse_expression, parse_real
+from .._precision import locked, workdps
 
 __all__ = [
     "conservative_period",
@@ -117,6 +118,7 @@ _SUPPORTED = (
 )
 
 
+@locked
 def as_mpmath_number(value: Any, name: str = "value") -> mpmath.mpf | mpmath.mpc:
     """Convert an exact or floating number to an mpmath number at the current precision.
 
@@ -217,7 +219,7 @@ def rounded_coefficients(results: list[tuple[mpmath.mpf, mpmath.mpf]], precision
     to one unit in the last digit.
     """
     results = [(value, error + abs(value) * mpmath.mpf(10) ** (-precision)) for value, error in results]
-    with mpmath.workdps(precision):
+    with workdps(precision):
         return [(+value, +error) for value, error in results]
 
 
@@ -1067,7 +1069,7 @@ def _turning_segment(
     working = mpmath.mp.dps
     length = turning - other
     threshold = mpmath.mpf(10) ** (-working)
-    with mpmath.workdps(2 * working):
+    with workdps(2 * working):
         symbolic = orbit.potential.pieces[piece].primitive is not None
         turning_primitive = orbit.potential.primitive(piece, turning) if symbolic else None
         limit = orbit.slope(turning, piece) * length  # D(s)/s**2 at s = 0
@@ -1075,7 +1077,7 @@ def _turning_segment(
         raise _separatrix_error()
 
     def integrand(s: mpmath.mpf) -> mpmath.mpf:
-        with mpmath.workdps(2 * working):
+        with workdps(2 * working):
             square = s * s
             if square <= threshold:
                 reduced = limit
@@ -1095,7 +1097,7 @@ def _inner_segment(
     working = mpmath.mp.dps
 
     def integrand(position: mpmath.mpf) -> mpmath.mpf:
-        with mpmath.workdps(2 * working):
+        with workdps(2 * working):
             excess = energy - orbit.value(position, piece)
             if excess <= 0:
                 raise _separatrix_error()
@@ -1151,7 +1153,7 @@ def _period_by_pieces(
         energy = orbit.value(a0, reference)
         other, other_piece = _piecewise_turning_point(orbit, a0, reference, direction, energy, scale)
         turning = sorted([(a0, reference), (other, other_piece)], key=lambda pair: pair[0])
-        with mpmath.workdps(2 * working):
+        with workdps(2 * working):
             energy = orbit.value(a0, reference)
     else:
         left, right = potential.locate(a0)
@@ -1162,7 +1164,7 @@ def _period_by_pieces(
             _piecewise_turning_point(orbit, a0, left, -1, energy, scale),
             _piecewise_turning_point(orbit, a0, right, 1, energy, scale),
         ]
-        with mpmath.workdps(2 * working):
+        with workdps(2 * working):
             energy = velocity**2 / 2 + orbit.value(a0, reference)
     (low, low_piece), (high, high_piece) = turning
     cuts = potential.cut_values()
@@ -1191,7 +1193,7 @@ def _period(
     velocity: Any = 0,
 ) -> tuple[mpmath.mpf, mpmath.mpf]:
     """Period and error at ``precision`` digits (computed with guard digits)."""
-    with mpmath.workdps(precision + 20):
+    with workdps(precision + 20):
         epsilon_value = real_parameter(epsilon, "epsilon")
         a0_value = real_parameter(a0, "a0")
         omega0_value = omega0_parameter(omega0)
@@ -1207,10 +1209,11 @@ def _period(
                 potential, epsilon_value, a0_value, velocity_value, omega0_value, precision + 5
             )
         error = difference + abs(period) * mpmath.mpf(10) ** (-precision)
-    with mpmath.workdps(precision):
+    with workdps(precision):
         return +period, +error
 
 
+@locked
 def conservative_period(
     f: Nonlinearity,
     epsilon: Any,
@@ -1289,6 +1292,7 @@ def conservative_period(
     return _period(potential, epsilon, a0, omega0, precision, velocity)
 
 
+@locked
 def conservative_frequency(
     f: Nonlinearity,
     epsilon: Any,
@@ -1313,14 +1317,15 @@ def conservative_frequency(
     """
     precision = validate_precision(precision)
     potential = _make_potential(f, breakpoints)
-    with mpmath.workdps(precision + 10):
+    with workdps(precision + 10):
         period, period_error = _period(potential, epsilon, a0, omega0, precision + 10, velocity)
         frequency = 2 * mpmath.pi / period
         error = frequency * period_error / period + abs(frequency) * mpmath.mpf(10) ** (-precision)
-    with mpmath.workdps(precision):
+    with workdps(precision):
         return +frequency, +error
 
 
+@locked
 def nonlinearity_breakpoints(f: Nonlinearity, *, breakpoints: Sequence[Any] | None = None) -> tuple[sympy.Expr, ...]:
     """The breakpoints at which the quadrature reference cuts the orbit (exact, increasing).
 
@@ -1457,6 +1462,7 @@ def _grazing_epsilon(
     return nearest
 
 
+@locked
 def frequency_taylor_coefficients(
     f: Nonlinearity,
     order: int,
@@ -1526,7 +1532,7 @@ def frequency_taylor_coefficients(
     potential = _make_potential(f, breakpoints)
     fine_nodes = 64  # the coarse grid is every other node (33 points)
     working_dps = precision + 15
-    with mpmath.workdps(working_dps):
+    with workdps(working_dps):
         a0_value = real_parameter(a0, "a0")
         omega0_value = omega0_parameter(omega0)
         velocity_value = real_parameter(velocity, "velocity")

@@ -19,6 +19,7 @@ from .._errors import OrderError
 from ..engine.stretched import FloatArc
 from ..export.display import DIGITS, format_number, format_vector, jupyter_latex, labelled_repr
 from ..export.json import JsonExport
+from .._precision import workdps
 
 __all__ = ["STRETCHED_TIME", "StretchedArcSeries"]
 
@@ -76,7 +77,7 @@ class StretchedArcSeries(JsonExport):
         """
         if order >= len(self.chebyshev):
             raise OrderError(f"the stretched arc is known through order {len(self.chebyshev) - 1}, not {order}")
-        with mpmath.workdps(self.digits + 15):
+        with workdps(self.digits + 15):
             rows = [[mpmath.mpf(c) for c in row] for row in self.chebyshev[: order + 1]]
             lengths = [mpmath.mpf(value) for value in self.length[: order + 1]]
 
