@@ -145,17 +145,27 @@ _HOMOTOPY_START_SLOPE = 0.5
 
 
 def _robust_point(problem: NNMShooting, epsilon: float, amplitude: _Amplitude, options: dict[str, Any], *,
-                  min_mode_share: float | None, guesses: tuple[str, ...] = ("linear", "expansion"),
-                  homotopy: bool = True) -> NNMResult:
+                  min_mode_share: float | None, guesses: tuple[str, ...] = ("linear",), homotopy: bool = True,
+                  near_linear: bool = True) -> NNMResult:
     """The NNM at (ε, amplitude), trying in turn the ``guesses`` and then a continuation in ε.
 
-    ``"linear"``: Newton from the linear mode j (exact at ε = 0); ``"expansion"``:
-    Newton from the strained-coordinates expansion (:func:`lindstedt.nnm`, order 2:
-    ω(ε) and the release state).  If both fail and ``homotopy``, the point is
-    reached by pseudo-arclength continuation in ε (with the resonance jumps of
-    :class:`_Arclength`) from the largest ``ε/2**k`` where the expansion holds and
-    its point converges, else from ε = 0 (the linear mode).  The message says
-    which route succeeded; the iterations and flows of every attempt are counted.
+    ``"linear"``: Newton from the linear mode j; ``"expansion"``: Newton from the
+    strained-coordinates expansion (:func:`lindstedt.nnm`, order 2: ω(ε) and the
+    release state).  With ``near_linear`` (the default route of :func:`nnm_point`
+    and of the first point of :func:`continue_nnm`) Newton from the linear mode is
+    kept only when it returns the linear mode itself (no spring touched: then it
+    *is* the NNM, exactly) or an orbit near it (:func:`_near_linear`: period and
+    release state within ``_NEAR_LINEAR`` of the linear mode's — the weakly
+    nonlinear NNM): an orbit reached by Newton far from its guess can be another
+    periodic orbit — on the SDND123 stop system at ε = 30 Newton from the linear
+    mode gave a 52-switch orbit at E = 10, a collapse T → 0 at E = 2.5 and the NNM
+    run 2, 3 or 12 times elsewhere.  Otherwise, and
+    if the guesses fail, the point is reached by pseudo-arclength continuation in
+    ε (with the resonance jumps of :class:`_Arclength`) from the largest
+    ``ε/2**k`` where the expansion holds and its point converges, else from ε = 0
+    (the linear mode): the NNM by its definition, the orbit that grows out of the
+    linear mode.  The message says which route succeeded; the iterations and
+    flows of every attempt are counted.
     """
     impossible = _impossible_amplitude(problem, epsilon, amplitude)
     if impossible:
@@ -174,9 +184,10 @@ def _robust_point(problem: NNMShooting, epsilon: float, amplitude: _Amplitude, o
                 continue
         result = problem._solve(guess, epsilon, amplitude, min_mode_share=min_mode_share, **options)
         iterations += result.newton_iterations
-        if result.success and kind == "expansion":
-            result = _minimal_period(problem, result, amplitude, options, min_mode_share)
-            iterations += result.newton_iterations
+        if result.success and near_linear and kind == "linear" and not _near_linear(problem, result, guess):
+            failures.append(f"Newton from {labels[kind]} reached an orbit far from it (ω = {result.frequency:.10g}, "
+                            f"{result.n_switches} switches), which need not be the NNM: not kept")
+            continue
         if result.success:
             note = f"; Newton from {labels[kind]} (before: {'; '.join(failures)})" if failures else ""
             return replace(result, message=result.message + note, newton_iterations=iterations)
@@ -192,21 +203,20 @@ def _robust_point(problem: NNMShooting, epsilon: float, amplitude: _Amplitude, o
     return replace(failed, flow_evaluations=problem.flow_evaluations)
 
 
-def _minimal_period(problem: NNMShooting, result: NNMResult, amplitude: _Amplitude, options: dict[str, Any],
-                    min_mode_share: float | None) -> NNMResult:
-    """``result``, or — when it is an orbit of period T/m run m times — that orbit re-solved at period T/m.
+#: Newton from the linear mode is kept when its orbit's period and release position are within this relative
+#: distance of the linear mode's (a multiple of the NNM has twice its period at least, a collapse none)
+_NEAR_LINEAR = 0.25
 
-    The returned ``newton_iterations`` are those of the re-solve only (0 when nothing was re-solved).
-    """
-    multiple = problem.period_multiple(result)
-    if multiple == 1:
-        return replace(result, newton_iterations=0, flow_evaluations=problem.flow_evaluations)
-    guess = problem._join(result.release_position, result.release_velocity, result.period / multiple)
-    again = problem._solve(guess, result.epsilon, amplitude, min_mode_share=min_mode_share, **options)
-    if not again.success:
-        return again
-    return replace(again, message=f"{again.message}; the first solution was this orbit run {multiple} times "
-                   f"(period {result.period:.6g}), re-solved at period T/{multiple}")
+
+def _near_linear(problem: NNMShooting, result: NNMResult, guess: np.ndarray) -> bool:
+    """Whether a verified orbit is the linear mode itself (ε = 0, or no switch and no spring engaged at the release
+    point) or within ``_NEAR_LINEAR`` of the linear-mode guess in period and release position."""
+    if result.epsilon == 0.0 or (result.n_switches == 0
+                                 and not np.any(problem.system.gaps(result.release_position) > 0)):
+        return True
+    x0, _, period = problem.split(guess)
+    return (abs(result.period - period) <= _NEAR_LINEAR * period
+            and float(np.linalg.norm(result.release_position - x0)) <= _NEAR_LINEAR * float(np.linalg.norm(x0)))
 
 
 def _homotopy(problem: NNMShooting, epsilon: float, amplitude: _Amplitude, options: dict[str, Any],
@@ -232,9 +242,6 @@ def _homotopy(problem: NNMShooting, epsilon: float, amplitude: _Amplitude, optio
                 if guess is not None:
                     result = problem._solve(guess, candidate, amplitude, min_mode_share=0.5, **options)
                     iterations += result.newton_iterations
-                    if result.success:
-                        result = _minimal_period(problem, result, amplitude, options, 0.5)
-                        iterations += result.newton_iterations
                     if result.success:
                         starts.append((candidate, result))
                 break
@@ -411,7 +418,7 @@ class _Attempt:
     reason: str = ""
     end: str | None = None
     complete: bool = False
-    jumped: bool = False  # the accepted point was reached by a parameter jump (see _Arclength.jump)
+    jumped: bool = False  # the accepted point was reached by a parameter jump (see _Arclength.jump); reason: why
     rejected: int = 0  # failed landings of a jump, counted as rejected steps
 
 
@@ -422,6 +429,7 @@ def _drive(stepper: _Stepper, start: float, stop: float, max_points: int,
     problem, path = stepper.problem, stepper.path
 
     jumps: list[int] = []
+    causes: list[str] = []  # what each jump stepped across
 
     def finish(points: list[NNMResult], values: list[float], stop_reason: str, success: bool, rejected: int,
                iterations: int) -> NNMBranch:
@@ -440,11 +448,18 @@ def _drive(stepper: _Stepper, start: float, stop: float, max_points: int,
         return bool(callback(ContinuationProgress(index, value, result, stepper.step, problem.flow_evaluations)))
 
     def reached() -> str:
-        if not jumps:
-            return f"reached stop = {stop:g}"
-        where = ", ".join(f"{values[k]:.4g}–{values[k + 1]:.4g}" for k in jumps)
-        return (f"reached stop = {stop:g}; {len(jumps)} turn(s) of the branch (internal-resonance tongues) crossed "
-                f"by parameter jumps ({stepper.label} in {where}; NNMBranch.jumps)")
+        text = f"reached stop = {stop:g}"
+        changes = [k for k in range(len(points) - 1) if points[k].contact_springs != points[k + 1].contact_springs]
+        if changes:
+            where = ", ".join(f"{values[k]:.6g}–{values[k + 1]:.6g} ({_springs(points[k])} → {_springs(points[k + 1])})"
+                              for k in changes[:6]) + (", …" if len(changes) > 6 else "")
+            text += (f"; {len(changes)} contact change(s) — the springs switching along the orbit change, a spring "
+                     f"grazes it: {stepper.label} in {where} (NNMBranch.contact_changes)")
+        if jumps:
+            where = "; ".join(f"{values[k]:.4g}–{values[k + 1]:.4g}: {cause}" for k, cause in zip(jumps, causes))
+            text += (f"; {len(jumps)} part(s) of the branch crossed by parameter jumps, not followed "
+                     f"({stepper.label} in {where}; NNMBranch.jumps)")
+        return text
 
     first = stepper.first(start)
     if not first.success:
@@ -473,6 +488,7 @@ def _drive(stepper: _Stepper, start: float, stop: float, max_points: int,
             continue
         if attempt.jumped:
             jumps.append(len(points) - 1)
+            causes.append(attempt.reason or "a turn of the branch")
         points.append(attempt.result)
         values.append(attempt.value)
         requested = notify(len(points) - 1, attempt.value, attempt.result)
@@ -521,7 +537,7 @@ class _Stepper(ABC):
         if self.initial is not None:
             return self.initial
         eps, amplitude = self.path.at(value)
-        return _robust_point(self.problem, eps, amplitude, self.options, min_mode_share=0.5)
+        return _robust_point(self.problem, eps, amplitude, self.options, min_mode_share=0.5)  # nnm_point's route
 
     def begin(self, first: NNMResult, value: float) -> str | None:
         return None
@@ -587,6 +603,13 @@ class _Natural(_Stepper):
         self.halvings = 0
 
 
+def _springs(result: NNMResult) -> str:
+    """The springs switching along an orbit, in words ("no contact" when none)."""
+    if not result.contact_springs:
+        return "no contact"
+    return "spring" + ("s " if len(result.contact_springs) > 1 else " ") + ", ".join(map(str, result.contact_springs))
+
+
 def _unknowns_of(problem: NNMShooting, result: NNMResult) -> np.ndarray:
     return problem._join(result.release_position, result.release_velocity, result.period)
 
@@ -608,6 +631,8 @@ _JUMP_GROWTH = 1.5
 _LANDING_RATIO = 0.5
 #: the scaled first correction of the corrector aimed at by the step control (the predictor's error)
 _PREDICTOR_ERROR = 2e-3
+#: where the springs switching along the orbit change, the step is refined to the initial one / 2**this
+_CONTACT_REFINEMENT = 3
 #: the longest jump, as a fraction of the range |stop − start|
 _JUMP_MAX_FRACTION = 0.25
 #: the landing point of a jump must carry at least min(this, _RELATIVE_MODE_SHARE × the base point's share) of
@@ -719,6 +744,8 @@ class _Arclength(_Stepper):
         self.regular = (self.tangent, self.scales, self.step)
         self.rescue: str | None = None
         self.rescued = False
+        #: the step is refined below this where the springs switching along the orbit change
+        self.h_refine = max(self.step / 2.0**_CONTACT_REFINEMENT, self.h_min)
         self.following: str | None = None  # why the branch is followed through a turn (jumps failed there)
         return None
 
@@ -773,6 +800,11 @@ class _Arclength(_Stepper):
                 f"{self.following}, and it leaves mode {problem.mode} at {self.label} = {value:.6g} "
                 f"(mode-{problem.mode} share {result.mode_share:.1%}, below half its {self.last_regular_share:.1%} "
                 f"where the turn began)"))
+        contact_changed = result.contact_springs != self.last.contact_springs
+        if contact_changed and h > self.h_refine:  # resolve the contact change: the backbone bends there
+            return _Attempt(iterations, value, reason=(
+                f"the springs switching along the orbit change within the step ({_springs(self.last)} → "
+                f"{_springs(result)}): the step is refined towards the contact change"))
         # tangent at the new point from the corrector's last Jacobian (no extra flow)
         new_scales = self.scales_at(result, value)
         previous = tangent * scales / new_scales
@@ -780,15 +812,18 @@ class _Arclength(_Stepper):
         new_tangent = self.tangent_of(outcome.last["augmented"], new_scales, previous)
         reference, slope = self.reference(), self.slope(new_tangent)
         turn = float(new_tangent @ previous)
-        turned = not (turn >= 0.9 or h <= self.h_min)
-        vertical = reference is not None and (slope < _VERTICAL_RATIO * reference
-                                              or (turned and slope < _REGULAR_RATIO * reference))
-        if vertical and not self.following:
-            # the branch turns vertical: a resonance tongue ahead — do not climb it, step across (if that fails,
-            # it is a fold of mode j: follow it)
+        # across a contact change (a small step by now) the tangent may turn and the λ-component drop: the branch
+        # has a corner or a steep part there (contact onset: dω/dλ jumps), not a resonance tongue — it is followed
+        turned = not (turn >= 0.9 or h <= self.h_min or contact_changed)
+        vertical = not contact_changed and reference is not None and (
+            slope < _VERTICAL_RATIO * reference or (turned and slope < _REGULAR_RATIO * reference))
+        other = self.other_mode(new_tangent, new_scales) if vertical else None
+        if other is not None and not self.following:
+            # the branch turns vertical towards another mode: a resonance tongue ahead — do not climb it, step
+            # across (if that fails, it is a fold of mode j: follow it).  Turning vertical in mode j itself is a
+            # steep part of the backbone (or a fold of mode j): followed, the step adapting to its curvature
             self.scales_at(self.last, values[-1])  # the residual scaling of the base point
-            jump = self.jump(iterations, self.resonance(self.other_mode(new_tangent, new_scales), result),
-                             extent=abs(value - values[-1]))
+            jump = self.jump(iterations, self.resonance(other, result), extent=abs(value - values[-1]))
             if jump.end is None:
                 return jump
             self.following = (f"{jump.end}; the branch is followed through the turn from {self.label} = "
@@ -820,6 +855,8 @@ class _Arclength(_Stepper):
         contact_changed = result.contact_springs != self.last.contact_springs
         self.w, self.scales, self.tangent, self.last = candidate, scales, tangent, result
         self.rescued = False
+        if contact_changed:  # a new contact regime: the λ-component of the tangent has a new level
+            self.slopes.clear()
         slope = self.slope(tangent)
         reference = self.reference()
         if not attempt.jumped:
@@ -899,8 +936,11 @@ class _Arclength(_Stepper):
                 rejected, last_reason = rejected + 1, result.message
                 self.scales_at(self.last, value0)
                 continue
+            cause = (f"a contact change ({_springs(self.last)} → {_springs(result)}: a spring grazes the orbit)"
+                     if result.contact_springs != self.last.contact_springs else why)
             if final:
-                return _Attempt(iterations, target, result, complete=True, jumped=True, rejected=rejected)
+                return _Attempt(iterations, target, result, reason=cause, complete=True, jumped=True,
+                                rejected=rejected)
             new_scales = self.scales_at(result, target)
             new_tangent = self.tangent_of(outcome.last["augmented"], new_scales, None)
             slope = self.slope(new_tangent)
@@ -908,7 +948,7 @@ class _Arclength(_Stepper):
                 self.pending = (np.r_[outcome.unknowns, target], new_scales, new_tangent, outcome, result,
                                 abs(target - value0))
                 self.step = step
-                return _Attempt(iterations, target, result, jumped=True, rejected=rejected)
+                return _Attempt(iterations, target, result, reason=cause, jumped=True, rejected=rejected)
             rejected += 1
             last_reason = (f"landed at {self.label} = {target:.6g} in a turn of the branch again "
                            f"({self.resonance(self.other_mode(new_tangent, new_scales), result)})")

@@ -47,6 +47,7 @@ from .._errors import LindstedtError, ProblemError
 from ..problems.forced import ForcedOscillator, ForcedSystem, check_forcing_frequency
 from ._period_map import PeriodMap, PeriodMapValue
 from .forced_results import Bifurcation, ForcedOrbit, FrequencyResponse
+from .results import _repetitions
 from .forced_setup import (
     _check_periods,
     _description,
@@ -118,12 +119,10 @@ def _orbit(count: _Counter, z: np.ndarray, frequency: float, scale: float, value
     multipliers = multipliers[np.argsort(-np.abs(multipliers), kind="stable")].astype(complex)
     nan = np.full(n, np.nan)
     minimal = k
-    if success:
-        for m in (d for d in range(1, k) if k % d == 0):
-            again = count(z, frequency, scale, sensitivity=False, periods=m).state
-            if np.max(np.abs(again - z)) <= max(1e3 * residual, 1e-7) * max(float(np.max(np.abs(z))), 1e-300):
-                minimal = m
-                break
+    if success:  # the one minimal-period rule of every periodic orbit (NNMs too): m repetitions of k/m periods
+        size = max(float(np.max(np.abs(z))), 1e-300)
+        minimal = k // _repetitions((m for m in range(2, k + 1) if k % m == 0), lambda m: float(np.max(np.abs(
+            count(z, frequency, scale, sensitivity=False, periods=k // m).state - z))) / size, residual)
         t, Z = flow.sample(z, frequency, periods=k, forcing_scale=scale, samples=samples)
         X, V = Z[:, :n], Z[:, n:]
         maximum = np.array([_hermite_extreme(t, X[:, i], V[:, i], 1.0) for i in range(n)])

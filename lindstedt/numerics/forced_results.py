@@ -50,7 +50,9 @@ class ForcedOrbit(JsonExport):
         k, the forcing periods of the orbit (of the map Π it is a fixed point of).
     minimal_periods : int
         The smallest divisor m of k with ``Π_m(z0) ≈ z0`` (1 for a period-k orbit run k times; k for
-        a true period-k orbit such as a period-doubled one).
+        a true period-k orbit such as a period-doubled one) — the rule every periodic orbit of the
+        package shares (:attr:`NNMResult.minimal_periods <lindstedt.numerics.NNMResult>` too): the state
+        after a part of the period is back within ``max(1e3 · residual, 1e-7)`` of ``z0`` (relative).
     epsilon : float or None
     state : numpy.ndarray, shape (2N,)
         ``z0 = (X(0), X'(0))``.

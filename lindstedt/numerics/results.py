@@ -20,7 +20,7 @@ Examples
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -62,11 +62,17 @@ class NNMResult(JsonExport):
     energy : float
         :func:`nnm_energy` of the release state.
     floquet_multipliers : numpy.ndarray, shape (2N,) or None
-        Eigenvalues of the monodromy matrix (over one full period), sorted by
-        distance to 1: the first two are the trivial ones (time shift and
-        family direction), equal to 1 up to about ``sqrt(machine ε)``.
+        Eigenvalues of the monodromy matrix (over one full period).  The first
+        two are the trivial pair — the monodromy restricted to the plane of
+        the flow direction and the family tangent, which it maps into itself
+        (both are 1 exactly; the computed ones carry the rounding of that
+        double eigenvalue, up to about ``sqrt(machine ε)``) — the others, the
+        non-trivial ones (:attr:`nontrivial_multipliers`), are the eigenvalues
+        of the monodromy on the quotient by that plane, sorted by distance to 1.
     stable : bool or None
-        Linear stability: all multipliers within ``1 + stability_tol`` of the unit circle.
+        Linear (orbital) stability: every non-trivial multiplier within
+        ``1 + stability_tol`` of the unit circle.  The trivial pair is deflated
+        by construction, so a neutral NNM is never reported unstable.
     residual : float
         Relative periodicity residual of the verification flow,
         ``max(|X(T) − X0|/x_s, |X'(T) − X1|/(ω x_s))``, x_s the orbit's scale.
@@ -91,6 +97,13 @@ class NNMResult(JsonExport):
         the whole orbit is not listed.  A change between two points of a branch
         is a spring whose gap ``A_i X − b_i`` starts or stops changing sign
         along the orbit: it grazes the orbit's turning point in between.
+    minimal_periods : int
+        How many times the orbit closes within ``period``: the minimal period
+        is ``period / minimal_periods``.  1 on every success (a solution that
+        is an orbit of period T/m run m times is re-solved at T/m or reported
+        as a failure with m here, and the message says so); checked by the one
+        rule of the forced orbits' ``minimal_periods`` too.  Not written into
+        ``nnm-numeric/1`` (the schema is unchanged).
 
     JSON schema ``lindstedt.nnm-numeric/1`` (:meth:`to_dict`, documented key by key).
     """
@@ -119,6 +132,17 @@ class NNMResult(JsonExport):
     monodromy: np.ndarray | None = field(default=None, repr=False)
     system: Any = field(default=None, repr=False, compare=False)  # the UnilateralSystem it was computed for
     contact_springs: tuple[int, ...] = field(default=(), compare=False)
+    minimal_periods: int = 1
+
+    @property
+    def minimal_period(self) -> float:
+        """The orbit's minimal period ``period / minimal_periods`` (equal to ``period`` on success)."""
+        return self.period / self.minimal_periods
+
+    @property
+    def nontrivial_multipliers(self) -> np.ndarray | None:
+        """The Floquet multipliers without the trivial pair (see :attr:`floquet_multipliers`), or None."""
+        return None if self.floquet_multipliers is None else self.floquet_multipliers[2:]
 
     @property
     def contact(self) -> bool:
@@ -132,10 +156,12 @@ class NNMResult(JsonExport):
 
     @property
     def max_abs_multiplier(self) -> float | None:
-        """The largest ``|μ|`` of the Floquet multipliers (None when they were not computed)."""
+        """The largest ``|μ|`` of the non-trivial Floquet multipliers (1.0 when there are none, as for one degree of
+        freedom; None when they were not computed)."""
         if self.floquet_multipliers is None or not np.size(self.floquet_multipliers):
             return None
-        return float(np.max(np.abs(self.floquet_multipliers)))
+        nontrivial = self.nontrivial_multipliers
+        return float(np.max(np.abs(nontrivial))) if np.size(nontrivial) else 1.0
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready data (schema ``lindstedt.nnm-numeric/1``); NaN and infinities become ``None``.
@@ -452,6 +478,36 @@ class NNMBranch(JsonExport):
             "points", ["index", self.parameter, "ε", "ω", "energy", "stable", "switches", "event (→: before the next point)"], table, note=note
         )
         return summary + points
+
+
+#: a state returns to the release state when it is within this factor of the verified periodicity residual …
+_RETURN_FACTOR = 1e3
+#: … or within this relative distance, whichever is larger
+_RETURN_FLOOR = 1e-7
+
+
+def _repetitions(candidates: Iterable[int], distance: Callable[[int], float], residual: float) -> int:
+    """How many times a verified periodic orbit is run within its computed period: the largest candidate m with
+    ``distance(m) ≤ max(1e3 · residual, 1e-7)``, else 1.
+
+    ``distance(m)`` is the relative distance between the release state and the state after ``1/m`` of the
+    computed period; ``residual`` is the orbit's relative periodicity residual (the return after the whole
+    period).  The one rule for the minimal period of every periodic orbit: the NNMs (m among the divisors of the
+    switch count, bounded by the shortest possible period) and the forced orbits (m among the divisors of the
+    forcing periods k; then ``minimal_periods = k // m``).
+
+    Examples
+    --------
+    >>> _repetitions([2, 3, 6], lambda m: 0.0 if m in (2, 3, 6) else 1.0, 1e-12)   # period T/6, run 6 times
+    6
+    >>> _repetitions([2, 3], lambda m: 0.4, 1e-12)
+    1
+    """
+    tol = max(_RETURN_FACTOR * residual, _RETURN_FLOOR)
+    for m in sorted({int(m) for m in candidates if m > 1}, reverse=True):  # the largest first: the shortest period
+        if distance(m) <= tol:
+            return m
+    return 1
 
 
 def _branch_events(points: Sequence[NNMResult], values: Sequence[float]) -> tuple[tuple[int, ...], ...]:

@@ -60,12 +60,17 @@ The Newton iteration is damped (backtracking on the scaled residual), solves
 in the least-squares sense with column scaling, and stops on a singular
 Jacobian (a fold, a bifurcation or a degenerate amplitude) with that reason.
 Every result is verified on its final state with one more flow over the full
-period: the periodicity residual is recomputed and the monodromy matrix gives
-the Floquet multipliers; an orbit that fails this check is never reported as a
-success.  A single solve from the linear-mode guess also rejects an orbit in
-which mode j does not carry at least half of the modal energy (Newton from a
-distant guess can land on another periodic orbit).  Branches of orbits are
-followed by :mod:`lindstedt.numerics.continuation`.
+period: the periodicity residual is recomputed, the period must be minimal (an
+orbit of period T/m run m times is re-solved at T/m, ``NNMResult.minimal_periods``),
+not collapsed (T above Yorke's bound 2π/L, L the Lipschitz constant of the flow)
+and not the rest state, and the monodromy matrix gives the Floquet multipliers,
+the trivial pair (flow direction, family tangent) deflated by construction; an
+orbit that fails this check is never reported as a success.  A single solve also
+rejects an orbit in which mode j does not carry at least half of the modal
+energy, and the default route of :func:`nnm_point` keeps Newton from the linear
+mode only near the linear mode — elsewhere the NNM is reached by continuation
+from it (Newton from a distant guess can land on another periodic orbit).
+Branches of orbits are followed by :mod:`lindstedt.numerics.continuation`.
 
 Examples
 --------
@@ -80,7 +85,7 @@ import math
 import threading
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -89,7 +94,7 @@ from .._errors import ConvergenceError, ProblemError
 from .flow import ExactFlow
 from ..problems.parsing import parse_float
 from ..problems.system import UnilateralSystem
-from .results import NNMResult
+from .results import NNMResult, _repetitions
 from .sensitivity import _check_epsilon, _integrate
 
 __all__ = ["NNMShooting", "nnm_energy", "nnm_point"]
@@ -195,6 +200,14 @@ def _check_mode(system: UnilateralSystem, mode: Any) -> int:
             f"mode must be an integer in 1..{system.n_dof} (1 = lowest linear frequency, as in the seed), got {mode!r}"
         )
     return int(mode)
+
+
+def _state_at(run: dict[str, Any], t: float) -> tuple[np.ndarray, np.ndarray]:
+    """The state at time t of a dense run of :class:`ExactFlow` (its closed-form arc containing t)."""
+    starts, modes, q0s, p0s = run["arcs"]
+    index = max(int(np.searchsorted(np.array(starts, dtype=float), t, side="right")) - 1, 0)
+    x, v = modes[index].evaluate(q0s[index], p0s[index], type(starts[index])(t) - starts[index])
+    return np.asarray(x, dtype=float), np.asarray(v, dtype=float)
 
 
 # --------------------------------------------------------------------------- #
@@ -436,42 +449,116 @@ class NNMShooting:
             return 1.0, self.mode
         return float(modal_energy[self.mode - 1] / total), int(np.argmax(modal_energy)) + 1
 
+    def shortest_period(self, epsilon: float) -> float:
+        """A lower bound ``2π / L`` of the period of every non-constant periodic orbit at ε (Yorke, 1969).
+
+        ``L`` bounds the Lipschitz constant of the vector field ``(X, X') ↦ (X', −M⁻¹(K X + ε W (A X − b)_+))``
+        in the norm ``|(√κ X, X')|``: every contact state's stiffness obeys
+        ``‖M⁻¹ K_S‖ ≤ κ = ‖M⁻¹ K‖ + |ε| Σ_i ‖M⁻¹ w_i‖ ‖a_i‖``, so ``L ≤ √κ``.  A shooting solution with a shorter
+        period is a collapse of the iteration (T → 0 solves the half-period equations), never an orbit.
+        """
+        system = self.system
+        stiffness = float(np.linalg.norm(np.linalg.solve(system.M, system.K), 2))
+        if system.n_springs:
+            loads = np.linalg.solve(system.M, system.W)
+            stiffness += abs(epsilon) * float(np.sum(np.linalg.norm(loads, axis=0) * np.linalg.norm(system.A, axis=1)))
+        return _TWO_PI / math.sqrt(stiffness)
+
+    def floquet(self, monodromy: np.ndarray, flow_vector: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(trivial pair, non-trivial multipliers) of an autonomous periodic orbit's monodromy matrix.
+
+        The flow direction ``f`` and the family tangent ``ξ`` span a plane the monodromy ``Φ`` maps into itself
+        (``Φ f = f``; ``Φ ξ = ξ − T' f`` along the family): their pair is ``(f, 0)`` and ``(ξ, T')`` of the
+        two-dimensional null space of ``[Φ − I, f]``, taken as its two smallest right singular vectors.  With U an
+        orthonormal basis of that plane and Q of its orthogonal complement, ``Φ`` is block triangular in (U, Q):
+        the trivial pair are the eigenvalues of ``Uᵀ Φ U`` and the non-trivial multipliers those of ``Qᵀ Φ Q``
+        (sorted by distance to 1) — deflated by construction, not by their distance to 1.
+        """
+        size = monodromy.shape[0]
+        bordered = np.column_stack([monodromy - np.eye(size), flow_vector / max(float(np.linalg.norm(flow_vector)),
+                                                                                 np.finfo(float).tiny)])
+        plane = np.linalg.svd(bordered)[2][-2:, :size].T
+        basis = np.linalg.qr(plane, mode="complete")[0] if np.linalg.matrix_rank(plane) == 2 else None
+        if basis is None:  # not a plane (the orbit is an equilibrium): nothing to deflate
+            trivial, nontrivial = np.array([], dtype=complex), np.linalg.eigvals(monodromy)
+        else:
+            U, Q = basis[:, :2], basis[:, 2:]
+            trivial = np.linalg.eigvals(U.T @ monodromy @ U)
+            nontrivial = np.linalg.eigvals(Q.T @ monodromy @ Q) if size > 2 else np.array([], dtype=complex)
+        nontrivial = nontrivial[np.argsort(np.abs(nontrivial - 1.0), kind="stable")]
+        return trivial.astype(complex), nontrivial.astype(complex)
+
     def verify(self, unknowns: np.ndarray, epsilon: float, *, verify_tol: float, stability_tol: float,
                iterations: int, amplitude: _Amplitude | None = None, formulation_label: str | None = None,
                min_mode_share: float | None = None, note: str = "") -> NNMResult:
-        """One flow over the full period: periodicity residual, monodromy, Floquet multipliers.
+        """One flow over the full period: periodicity, minimal period, monodromy, Floquet multipliers.
 
-        With ``min_mode_share``, an orbit whose mode-j share of the modal
-        energy is below it is reported as a failure (Newton from a distant
-        guess can land on another periodic orbit, e.g. a resonant one).
+        A success is the right orbit: the state returns after T (``verify_tol``), the amplitude condition holds,
+        T is above the shortest possible period (:meth:`shortest_period`; a collapse T → 0 is not an orbit), the
+        release state is not the equilibrium, and T is the minimal period — an orbit of period T/m run m times
+        (the same closed-form flow, the state at T/m back at the release state by the rule of
+        :func:`~lindstedt.numerics.results._repetitions`) is a failure with ``minimal_periods = m`` (:meth:`_solve`
+        re-solves it at T/m).  With ``min_mode_share``, an orbit whose mode-j share of the modal energy is below
+        it is a failure too (Newton from a distant guess can land on another periodic orbit, e.g. a resonant one).
+        The stability counts the non-trivial multipliers only (:meth:`floquet`).
         """
         amplitude = amplitude or self.amplitude
         label = formulation_label or self.formulation
         x0, v0, period = self.split(unknowns)
         if not (math.isfinite(period) and period > 0):
             return self._failure(epsilon, f"invalid period T = {period}", iterations, label=label, x0=x0)
+        shortest = self.shortest_period(epsilon)
+        if period < shortest:
+            return self._failure(epsilon, (
+                f"degenerate solution: the period T = {period:.3g} collapsed below {shortest:.6g}, the shortest period "
+                f"of any periodic orbit at ε = {epsilon:g} (2π/L, L the Lipschitz constant of the flow: Yorke's "
+                f"bound){note}"), iterations, label=label, x0=x0)
         self.flow_evaluations += 1
-        trajectory = _integrate(self._flow(epsilon), x0, v0, period, sensitivity=True, d_epsilon=False)
-        if not trajectory.success:
-            return self._failure(epsilon, trajectory.message, iterations, label=label, x0=x0)
+        flow = self._flow(epsilon)
+        try:
+            run = flow._run(x0, v0, period, dense=True, sensitivity=True)
+        except ProblemError as error:
+            return self._failure(epsilon, f"the flow failed: {error}", iterations, label=label, x0=x0)
+        if not run["success"]:
+            return self._failure(epsilon, f"the flow failed: {run['message']}", iterations, label=label, x0=x0)
         frequency = _TWO_PI / period
+        equilibrium = _equilibrium(self.system, epsilon)
         scale = max(float(np.max(np.abs(x0))), float(np.max(np.abs(v0))) / frequency, np.finfo(float).tiny)
-        residual = max(
-            float(np.max(np.abs(trajectory.position - x0))) / scale,
-            float(np.max(np.abs(trajectory.velocity - v0))) / (frequency * scale),
-        )
+
+        def distance(x: np.ndarray, v: np.ndarray) -> float:
+            return max(float(np.max(np.abs(x - x0))), float(np.max(np.abs(v - v0))) / frequency) / scale
+
+        residual = distance(run["x"], run["v"])
+        switches = len(run["events"])
+        springs = tuple(sorted({event.spring for event in run["events"]}))
+        # the orbit is run m times in T only if m divides its switch count (and T/m is a possible period)
+        longest = int(period // shortest)
+        candidates = [m for m in range(2, longest + 1) if switches % m == 0]
+        repetitions = _repetitions(candidates, lambda m: distance(*_state_at(run, period / m)), residual)
         amp_value, _, _, _ = self._amplitude_row(x0, v0, epsilon, amplitude)
         amp_scale = max(abs(amplitude.target(epsilon)), self.amplitude_scale, np.finfo(float).tiny)
         amplitude_error = abs(amp_value) / amp_scale
-        monodromy = trajectory.sensitivity
-        multipliers = np.linalg.eigvals(monodromy)
-        multipliers = multipliers[np.argsort(np.abs(multipliers - 1.0), kind="stable")]
-        stable = bool(np.max(np.abs(multipliers)) <= 1.0 + stability_tol)
+        monodromy = run["jacobian"]
+        flow_vector = np.r_[v0, self.system.acceleration(x0, epsilon)]
+        trivial, nontrivial = self.floquet(monodromy, flow_vector)
+        multipliers = np.r_[trivial, nontrivial]
+        stable = bool(np.max(np.abs(nontrivial), initial=0.0) <= 1.0 + stability_tol)
         share, dominant = self.mode_share(x0, v0)
+        at_rest = max(float(np.max(np.abs(x0 - equilibrium))), float(np.max(np.abs(v0))) / frequency) <= \
+            1e-12 * max(float(np.max(np.abs(equilibrium))), 1.0)
         if not (residual <= verify_tol and amplitude_error <= verify_tol):
             success, message = False, (
                 f"verification failed: periodicity residual {residual:.2e}, amplitude residual "
                 f"{amplitude_error:.2e} over one full period (verify_tol = {verify_tol:.1e}){note}"
+            )
+        elif at_rest:
+            success, message = False, (f"degenerate solution: the release state is the static equilibrium (the "
+                                       f"amplitude collapsed), not a periodic orbit{note}")
+        elif repetitions > 1:
+            success, message = False, (
+                f"not a minimal period: the state returns to the release state after T/{repetitions} = "
+                f"{period / repetitions:.10g} ({switches // repetitions} switches), so this is an orbit of period "
+                f"T/{repetitions} run {repetitions} times (ω would be reported {repetitions} times too small){note}"
             )
         elif min_mode_share is not None and share < min_mode_share:
             success, message = False, (
@@ -480,42 +567,30 @@ class NNMShooting:
                 "(continue_nnm from the linear mode, or initial_guess=)"
             )
         else:
-            contact = "" if trajectory.n_switches else "; no contact along the orbit: it is the linear mode (ω = λ_j)"
             success, message = True, (
-                f"converged in {iterations} iterations, verified residual {residual:.1e}{contact}{note}"
+                f"converged in {iterations} iterations, verified residual {residual:.1e}"
+                f"{self._contact_words(x0, switches, epsilon)}{note}"
             )
         return NNMResult(
             success=success, message=message, mode=self.mode, epsilon=epsilon, frequency=frequency, period=period,
             linear_frequency=self.linear_frequency, release_position=np.array(x0), release_velocity=np.array(v0),
             modal_coordinates=self.projector @ x0, energy=nnm_energy(self.system, x0, v0, epsilon),
-            floquet_multipliers=multipliers, stable=stable, residual=residual, n_switches=trajectory.n_switches,
+            floquet_multipliers=multipliers, stable=stable, residual=residual, n_switches=switches,
             mode_share=share, formulation=label, newton_iterations=iterations,
             flow_evaluations=self.flow_evaluations, monodromy=monodromy, system=self.system,
-            contact_springs=trajectory.springs,
+            contact_springs=springs, minimal_periods=repetitions,
         )
 
-    def period_multiple(self, result: NNMResult, *, largest: int = 6, tol: float = 1e-6) -> int:
-        """The m ≤ ``largest`` such that the verified orbit ``result`` is an orbit of period T/m run m times (else 1).
-
-        Newton from a distant guess (an expansion far beyond its validity) can converge to a true periodic
-        orbit with its period multiplied: the shooting equations hold for it too.  One dense flow over T,
-        the state at T/m compared with the release state (relative ``tol``).
-        """
-        if not (result.success and result.period > 0):
-            return 1
-        self.flow_evaluations += 1
-        trajectory = self._flow(result.epsilon).solve(result.release_position, result.release_velocity, result.period)
-        if not trajectory.success:
-            return 1
-        scale = max(float(np.max(np.abs(result.release_position))),
-                    float(np.max(np.abs(result.release_velocity))) / result.frequency, np.finfo(float).tiny)
-        for m in range(largest, 1, -1):  # the largest m first: the shortest period found wins
-            x, v = trajectory.state(result.period / m)
-            error = max(float(np.max(np.abs(x - result.release_position))),
-                        float(np.max(np.abs(v - result.release_velocity))) / result.frequency) / scale
-            if error <= tol:
-                return m
-        return 1
+    def _contact_words(self, x0: np.ndarray, switches: int, epsilon: float) -> str:
+        """What the message says of an orbit without switches: free of every spring (the linear mode, ω = λ_j) or
+        engaged on some springs all along (a linear mode of the stiffened system) — read from the release state."""
+        if switches or not self.system.n_springs:
+            return "" if switches else "; no contact along the orbit: it is the linear mode (ω = λ_j)"
+        engaged = tuple(int(i) for i in np.flatnonzero(self.system.gaps(x0) > 0))
+        if not engaged or epsilon == 0:
+            return "; no contact along the orbit: it is the linear mode (ω = λ_j)"
+        return (f"; permanent contact with spring(s) {', '.join(map(str, engaged))} (engaged at every instant, no "
+                "switch): a linear mode of the stiffened system")
 
     def _failure(self, epsilon: float, message: str, iterations: int = 0, *, label: str | None = None,
                  x0: np.ndarray | None = None) -> NNMResult:
@@ -535,7 +610,30 @@ class NNMShooting:
     def _solve(self, z0: np.ndarray, epsilon: float, amplitude: _Amplitude | None = None, *, tol: float,
                max_iterations: int, verify_tol: float, stability_tol: float,
                min_mode_share: float | None = None) -> NNMResult:
-        """Newton from the unknowns z0 at fixed (ε, amplitude), scaled by z0, then the full-period verification."""
+        """Newton from the unknowns z0 at fixed (ε, amplitude), scaled by z0, then the full-period verification.
+
+        A solution that is an orbit of period T/m run m times (:meth:`verify`) is re-solved once from its own
+        release state at T/m; the result says so, or fails with both reasons.
+        """
+        options = dict(tol=tol, max_iterations=max_iterations, verify_tol=verify_tol, stability_tol=stability_tol,
+                       min_mode_share=min_mode_share)
+        first = self._newton_verify(z0, epsilon, amplitude, **options)
+        m = first.minimal_periods
+        if first.success or m == 1:
+            return first
+        guess = self._join(first.release_position, first.release_velocity, first.period / m)
+        result = self._newton_verify(guess, epsilon, amplitude, **options)
+        iterations = first.newton_iterations + result.newton_iterations
+        if result.success:
+            return replace(result, newton_iterations=iterations, message=(
+                f"{result.message}; the first solution was this orbit run {m} times (period {first.period:.10g}), "
+                f"re-solved at its minimal period T/{m}"))
+        return replace(result, newton_iterations=iterations, message=(
+            f"{first.message}; re-solving at T/{m} failed: {result.message}"))
+
+    def _newton_verify(self, z0: np.ndarray, epsilon: float, amplitude: _Amplitude | None, *, tol: float,
+                       max_iterations: int, verify_tol: float, stability_tol: float,
+                       min_mode_share: float | None) -> NNMResult:
         x_guess, _, period_guess = self.split(z0)
         self.set_scales(epsilon, x_guess if np.max(np.abs(x_guess)) > 0 else None, period_guess, amplitude)
         outcome = _newton(lambda z: self.evaluate(z, epsilon, amplitude=amplitude), z0, self.column_scales(), tol=tol,
@@ -599,9 +697,13 @@ def _newton(
     norm = float(np.max(np.abs(current["residual"])))
     sizes: list[float] = []
     for iteration in range(1, max_iterations + 1):
-        if norm <= tol:
-            return _NewtonOutcome(True, f"residual {norm:.1e}", z, iteration - 1, current, tuple(sizes))
         step, ratio = _scaled_solve(current[jacobian_key], -current["residual"], columns)
+        if norm <= tol:
+            # converged: the Newton step already computed polishes the last digits (quadratic convergence), as a
+            # step ≤ step_tol below; the caller verifies the final state
+            polish = step is not None and float(np.max(np.abs(step / columns))) <= step_tol
+            return _NewtonOutcome(True, f"residual {norm:.1e}", z + step if polish else z, iteration - 1, current,
+                                  tuple(sizes))
         if step is None:
             return _NewtonOutcome(
                 False,
@@ -786,8 +888,13 @@ def nnm_point(
         fails (ε beyond the expansion's validity), continuation in ε
         (:func:`continue_nnm`, with its resonance jumps) from the largest
         ``ε/2**k`` where the expansion holds, or from ε = 0.  None (default):
-        the linear mode first, then as ``"expansion"``.  The message names the
-        route that succeeded; the cost counters include every attempt.
+        Newton from the linear mode, kept only when its orbit is the linear mode
+        or near it (period and release position within 25 %: the weakly
+        nonlinear NNM); otherwise the continuation in ε above — the NNM by its
+        definition, the orbit that grows out of the linear mode (Newton from the
+        linear mode far from it can land on another orbit, or on the NNM run
+        several times).  The message names the route that succeeded; the cost
+        counters include every attempt.
     release_sign : {1, -1}
         Energy amplitudes: release on the ``+φ_j`` or ``−φ_j`` side.
     tol : float
@@ -807,7 +914,9 @@ def nnm_point(
     NNMResult
         ``success`` is False (with the reason in ``message``: every route
         tried) on an impossible energy, a singular Jacobian, no convergence, a
-        flow failure or a failed verification; no exception is raised for those.
+        flow failure, a failed verification or a degenerate solution (period
+        collapsed, rest state, not a minimal period that re-solving at T/m could
+        not repair); no exception is raised for those.
 
     Examples
     --------
@@ -828,14 +937,15 @@ def nnm_point(
         return problem._failure(epsilon, impossible)
     options = dict(tol=tol, max_iterations=max_iterations, verify_tol=verify_tol, stability_tol=stability_tol)
     if initial_guess is None or isinstance(initial_guess, str):
-        routes = {None: ("linear", "expansion"), "linear": ("linear",), "expansion": ("expansion",)}
+        routes = {None: ("linear",), "linear": ("linear",), "expansion": ("expansion",)}
         if initial_guess not in routes:
             raise ProblemError(f"initial_guess must be an NNMResult, a pair (X0, T), 'linear', 'expansion' or None, "
                                f"got {initial_guess!r}")
         from .continuation import _robust_point  # here: the continuation module imports this one
 
         return _robust_point(problem, epsilon, problem.amplitude, options, min_mode_share=min_mode_share,
-                             guesses=routes[initial_guess], homotopy=initial_guess != "linear")
+                             guesses=routes[initial_guess], homotopy=initial_guess != "linear",
+                             near_linear=initial_guess is None)
     return problem._solve(_guess_unknowns(problem, epsilon, initial_guess), epsilon,
                           min_mode_share=min_mode_share, **options)
 
