@@ -11,6 +11,7 @@
 
 import os
 import pathlib
+import re
 import shutil
 
 DOCS = pathlib.Path(__file__).resolve().parent
@@ -35,8 +36,51 @@ def _prepare_gallery(app, config) -> None:
     os.environ["MPLBACKEND"] = "module://matplotlib_inline.backend_inline"
 
 
+# sphinx.ext.viewcode links each object of a source page back to its entry as "#<module>.<name>", with ONE module
+# per source file (the first one it was documented under); the facade re-exports names of modules whose other names
+# are documented under their subpackage (lindstedt.ExactFlow next to lindstedt.numerics.FlowResult, both from
+# numerics/flow.py), so those [docs] links missed.  The targets are recorded as the pages are read and the links set
+# to them when the source pages are written (a source object documented nowhere loses its link).
+def _record_viewcode_targets(app, doctree) -> None:
+    from sphinx import addnodes
+    from sphinx.ext.viewcode import viewcode_anchor
+
+    targets = app.env.__dict__.setdefault("lindstedt_viewcode_targets", {})
+    for signature in doctree.findall(addnodes.desc_signature):
+        for anchor in signature.findall(viewcode_anchor):
+            if signature["ids"]:
+                targets[anchor["reftarget"], anchor["refid"]] = (app.env.docname, signature["ids"][0])
+
+
+def _purge_viewcode_targets(app, env, docname) -> None:
+    targets = env.__dict__.get("lindstedt_viewcode_targets", {})
+    for key in [key for key, (target_doc, _) in targets.items() if target_doc == docname]:
+        del targets[key]
+
+
+_BACKLINK = re.compile(r'(<div class="viewcode-block" id="([^"]+)">\n)<a class="viewcode-back" href="[^"]*">([^<]*)</a>\n')
+
+
+def _fix_viewcode_backlinks(app, pagename, templatename, context, doctree) -> None:
+    if not pagename.startswith("_modules/") or "body" not in context:
+        return
+    targets = app.env.__dict__.get("lindstedt_viewcode_targets", {})
+
+    def link(match) -> str:
+        target = targets.get((pagename, match.group(2)))
+        if target is None:
+            return match.group(1)
+        href = app.builder.get_relative_uri(pagename, target[0]) + "#" + target[1]
+        return f'{match.group(1)}<a class="viewcode-back" href="{href}">{match.group(3)}</a>\n'
+
+    context["body"] = _BACKLINK.sub(link, context["body"])
+
+
 def setup(app):
     app.connect("config-inited", _prepare_gallery)
+    app.connect("doctree-read", _record_viewcode_targets, priority=600)  # after viewcode's own (500)
+    app.connect("env-purge-doc", _purge_viewcode_targets)
+    app.connect("html-page-context", _fix_viewcode_backlinks)
 
 
 project = "lindstedt"
@@ -45,6 +89,8 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
+    # MathJax 3 served from the built site (_static/mathjax/), not from a CDN: formulas render offline
+    "sphinx-mathjax-offline",
     "sphinx.ext.viewcode",
     "matplotlib.sphinxext.plot_directive",
     "myst_nb",

@@ -168,3 +168,81 @@ def test_import_and_help_load_no_numerical_library():
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert result.stdout.split("\n")[:2] == ["[]", "True"], result.stdout + result.stderr
+
+
+# --------------------------------------------------------------------------- the facade, __all__ and the API reference
+API_PAGE = ROOT / "docs" / "api.rst"
+
+
+def _automodule_blocks(text: str) -> dict[str, dict[str, str]]:
+    """``.. automodule::`` directives of an rst page: module → its options (continuation lines joined)."""
+    blocks: dict[str, dict[str, str]] = {}
+    current = None
+    option = None
+    for line in text.splitlines():
+        match = re.match(r"^\.\. automodule:: (\S+)\s*$", line)
+        if match:
+            current = blocks.setdefault(match.group(1), {})
+            option = None
+        elif current is not None and (found := re.match(r"^   :([\w-]+):(.*)$", line)):
+            option = found.group(1)
+            current[option] = found.group(2).strip()
+        elif current is not None and option and re.match(r"^ {4,}\S", line):
+            current[option] += " " + line.strip()
+        elif line.strip():
+            current = option = None
+    return blocks
+
+
+def _documented_names(module_name: str, options: dict[str, str]) -> set[str]:
+    """The names an ``automodule`` documents: the module's ``__all__`` (``:members:`` without a list honours it)."""
+    module = importlib.import_module(module_name)
+    assert "members" in options and not options["members"], f"{module_name}: document its __all__ (:members: with no list)"
+    excluded = {name.strip() for name in options.get("exclude-members", "").split(",") if name.strip()}
+    return set(module.__all__) - excluded
+
+
+def _facade_names() -> set[str]:
+    """What ``dir(lindstedt)`` offers a user: no dunder (``__version__``), no private name, no submodule."""
+    import lindstedt
+
+    return {name for name in dir(lindstedt) if not name.startswith("_") and not isinstance(getattr(lindstedt, name), type(sys))}
+
+
+def test_the_facade_offers_exactly_its_all():
+    import lindstedt
+
+    names = _facade_names()
+    assert names == set(lindstedt.__all__), (
+        f"in dir(lindstedt), not in __all__: {sorted(names - set(lindstedt.__all__))}; "
+        f"in __all__, not in dir: {sorted(set(lindstedt.__all__) - names)}")
+    # the forced-response API is part of the facade
+    assert {"ForcedOscillator", "ForcedSystem", "MultipleScales", "frequency_response_curve", "FrequencyResponseCurve",
+            "forced_flow", "forced_periodic_orbit", "ForcedOrbit", "frequency_response", "FrequencyResponse",
+            "switch_period_doubling"} <= names
+
+
+def test_the_api_reference_documents_every_public_name_once():
+    blocks = _automodule_blocks(API_PAGE.read_text(encoding="utf-8"))
+    assert set(blocks) == {"lindstedt", "lindstedt.plot", *SUBPACKAGES}, sorted(blocks)
+    import lindstedt
+
+    facade = _documented_names("lindstedt", blocks["lindstedt"])
+    assert facade == _facade_names(), sorted(facade ^ _facade_names())
+    for module_name, options in blocks.items():
+        assert "no-index" not in options, f"{module_name}: indexed, so that its entries can be linked"
+    for module_name in SUBPACKAGES:
+        module = importlib.import_module(module_name)
+        documented = _documented_names(module_name, blocks[module_name])
+        # a name left out of a subpackage's section is the facade's own object, documented there
+        skipped = sorted(name for name in set(module.__all__) - documented
+                         if getattr(module, name) is not getattr(lindstedt, name, None))
+        assert skipped == [], f"{module_name} leaves out names that the facade does not document: {skipped}"
+        # and one object is documented once
+        twice = sorted(name for name in documented if getattr(module, name) is getattr(lindstedt, name, None))
+        assert twice == [], f"{module_name} documents the facade's objects again: {twice}"
+
+
+def test_the_automodule_reader_reads_options():
+    text = ".. automodule:: a.b\n   :members:\n   :exclude-members: x, y,\n                     z\n\nProse\n"
+    assert _automodule_blocks(text) == {"a.b": {"members": "", "exclude-members": "x, y, z"}}
