@@ -21,16 +21,25 @@ how they step:
     predictor's error), its iterations, contact changes and the turn of the
     tangent; the Floquet multipliers of every point give the stability along
     the branch; the last point is solved at exactly ``λ = stop``.
+    Contact changes: where the springs switching along the orbit change (a
+    spring grazes the orbit — at the contact onset the backbone has a kink
+    and a steep part, dω/dλ jumps), a step across is refined to 1/8 of the
+    initial step and the branch is followed through the corner and the steep
+    part (the tangent may turn and its λ-component drop there: that is not a
+    resonance); the stop reason names each contact change.
     Internal resonances: where ``λ_k ≈ n ω`` the branch of mode j meets a
     resonance tongue of mode k — the arc turns vertical (λ stops advancing)
-    and climbing it stalls the continuation (the 20-dof chain with three
-    springs did so at ε ≈ 0.011 after 330 points).  When the tangent's
-    λ-component collapses, the method *jumps*: it solves at fixed λ further and
-    further beyond (predictor: the last regular tangent) and lands on the first
-    regular point of mode j (``NNMBranch.jumps``).  If no landing succeeds, the turn is a
-    fold of mode j itself and is followed, until the branch leaves mode j.
-    A step that would shrink below ``min_step`` is rescued once by the same
-    jump; the branch never ends without a reason naming where and why.
+    *towards mode k* and climbing it stalls the continuation (the 20-dof chain
+    with three springs did so at ε ≈ 0.011 after 330 points).  When the
+    tangent's λ-component collapses and mode k dominates it, the method *jumps*:
+    it solves at fixed λ further and further beyond (predictor: the last
+    regular tangent) and lands on the first regular point of mode j
+    (``NNMBranch.jumps``, the stop reason names what each jump crossed).  If no
+    landing succeeds, the turn is a fold of mode j itself and is followed,
+    until the branch leaves mode j; a turn that stays in mode j (a steep part
+    of the backbone, or a fold) is followed from the start.  A step that would
+    shrink below ``min_step`` is rescued once by the same jump; the branch
+    never ends without a reason naming where and why.
 ``"natural"`` — natural-parameter continuation
     λ steps with the secant-extrapolated previous solution as guess and Newton
     at fixed λ, the step halved on failure.
@@ -335,8 +344,12 @@ def continue_nnm(
         across a change of the springs touching the orbit, halved after a
         failure or a turn of the tangent by more than ~25°; the last point is
         solved at exactly ``λ = stop``.
-        Where the branch turns vertical (its tangent's λ-component falls below
-        half its recent level: an internal-resonance tongue), the method jumps
+        A step across which the springs switching along the orbit change is
+        refined to 1/8 of the initial step, then the branch is followed through
+        that corner (contact onset: the backbone turns steep there).
+        Where the branch turns vertical towards another mode (its tangent's
+        λ-component falls below half its recent level and another mode
+        dominates the tangent: an internal-resonance tongue), the method jumps
         across at fixed λ to the next regular point of mode j (up to 8 landings,
         distances growing ×1.5 from the recent step's λ-extent, at most a
         quarter of the range; ``NNMBranch.jumps``); if none lands, the turn is
@@ -653,7 +666,8 @@ class _Arclength(_Stepper):
     itself).  Followed faithfully, pseudo-arclength climbs the tongue and the
     parameter stalls.  So when the λ-component of the unit tangent falls below
     ``_VERTICAL_RATIO`` of its recent level (or the tangent turns too much and
-    it falls below ``_REGULAR_RATIO``), the step is not taken: :meth:`jump`
+    it falls below ``_REGULAR_RATIO``) and another mode dominates the tangent
+    (:meth:`other_mode`), the step is not taken: :meth:`jump`
     solves at fixed λ beyond it (distances growing ×``_JUMP_GROWTH`` from the
     λ-extent of the recent steps, at most ``_JUMP_MAX_FRACTION`` of the range;
     predictor: the last regular tangent) and lands on the first point of mode j
@@ -1058,9 +1072,10 @@ def nnm_sweep(
 ) -> list[NNMResult]:
     """NNM points at many parameter values, optionally in parallel; results in input order.
 
-    Each point is solved independently by :func:`nnm_point` from the linear
-    mode (no continuation between points): use :func:`continue_nnm` for
-    strongly nonlinear points, or pass ``initial_guess`` in ``options``.
+    Each point is solved independently by :func:`nnm_point`'s default route
+    (Newton from the linear mode near it, else continuation in ε from it; no
+    continuation between the points): :func:`continue_nnm` follows a branch
+    with fewer flows, or pass ``initial_guess`` in ``options``.
 
     Parameters
     ----------

@@ -344,7 +344,9 @@ class NNMBranch(JsonExport):
         across an internal resonance (method "arclength": the branch of mode j
         turns there into a resonance tongue of another mode, which is not
         followed; see :func:`~lindstedt.numerics.continue_nnm`), not by a
-        continuous arc.
+        continuous arc; ``stop_reason`` says what each jump crossed.  Contact
+        changes (``contact_changes``, e.g. the contact onset where the
+        backbone turns steep) are followed, not jumped.
 
     JSON schema ``lindstedt.nnm-branch/1`` (:meth:`to_json`; every point as
     its ``lindstedt.nnm-numeric/1`` dictionary).

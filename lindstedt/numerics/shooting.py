@@ -478,13 +478,10 @@ class NNMShooting:
         bordered = np.column_stack([monodromy - np.eye(size), flow_vector / max(float(np.linalg.norm(flow_vector)),
                                                                                  np.finfo(float).tiny)])
         plane = np.linalg.svd(bordered)[2][-2:, :size].T
-        basis = np.linalg.qr(plane, mode="complete")[0] if np.linalg.matrix_rank(plane) == 2 else None
-        if basis is None:  # not a plane (the orbit is an equilibrium): nothing to deflate
-            trivial, nontrivial = np.array([], dtype=complex), np.linalg.eigvals(monodromy)
-        else:
-            U, Q = basis[:, :2], basis[:, 2:]
-            trivial = np.linalg.eigvals(U.T @ monodromy @ U)
-            nontrivial = np.linalg.eigvals(Q.T @ monodromy @ Q) if size > 2 else np.array([], dtype=complex)
+        basis = np.linalg.qr(plane, mode="complete")[0]
+        U, Q = basis[:, :2], basis[:, 2:]
+        trivial = np.linalg.eigvals(U.T @ monodromy @ U)
+        nontrivial = np.linalg.eigvals(Q.T @ monodromy @ Q) if size > 2 else np.array([], dtype=complex)
         nontrivial = nontrivial[np.argsort(np.abs(nontrivial - 1.0), kind="stable")]
         return trivial.astype(complex), nontrivial.astype(complex)
 
