@@ -456,6 +456,12 @@ class NNMShooting:
         in the norm ``|(√κ X, X')|``: every contact state's stiffness obeys
         ``‖M⁻¹ K_S‖ ≤ κ = ‖M⁻¹ K‖ + |ε| Σ_i ‖M⁻¹ w_i‖ ‖a_i‖``, so ``L ≤ √κ``.  A shooting solution with a shorter
         period is a collapse of the iteration (T → 0 solves the half-period equations), never an orbit.
+
+        Examples
+        --------
+        >>> problem = NNMShooting(UnilateralSystem.one_dof(1), 1, modal_amplitude=1.0)
+        >>> bool(problem.shortest_period(3.0) == np.pi)   # κ = 1 + 3: L = 2; the bilinear orbit has T = 3π/2
+        True
         """
         system = self.system
         stiffness = float(np.linalg.norm(np.linalg.solve(system.M, system.K), 2))
@@ -473,6 +479,16 @@ class NNMShooting:
         orthonormal basis of that plane and Q of its orthogonal complement, ``Φ`` is block triangular in (U, Q):
         the trivial pair are the eigenvalues of ``Uᵀ Φ U`` and the non-trivial multipliers those of ``Qᵀ Φ Q``
         (sorted by distance to 1) — deflated by construction, not by their distance to 1.
+
+        Examples
+        --------
+        Two uncoupled oscillators ``λ = 1, 2`` over ``T = 2π``: the monodromy is the identity, the trivial pair
+        belongs to the mode carrying the orbit (flow vector in its plane), the other pair is non-trivial:
+
+        >>> problem = NNMShooting(UnilateralSystem(M=[[1, 0], [0, 1]], K=[[1, 0], [0, 4]]), 1, modal_amplitude=1.0)
+        >>> trivial, nontrivial = problem.floquet(np.eye(4), np.array([0.0, 0.0, -1.0, 0.0]))
+        >>> np.round(trivial.real, 12).tolist(), np.round(nontrivial.real, 12).tolist()
+        ([1.0, 1.0], [1.0, 1.0])
         """
         size = monodromy.shape[0]
         bordered = np.column_stack([monodromy - np.eye(size), flow_vector / max(float(np.linalg.norm(flow_vector)),
