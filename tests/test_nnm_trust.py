@@ -164,3 +164,18 @@ def test_the_contact_onset_is_resolved_and_named(branch):
     steep = [(e, w) for e, w in zip(energies, branch.frequencies) if onset < e < 1.95]
     assert len(steep) >= 5
     assert max(np.diff([w for _, w in steep])) < 0.06
+
+
+def test_the_steep_part_is_followed_in_the_modal_amplitude_too():
+    # with u_2(0) fixed, the tangent after the contact onset is mostly mode 1 while the period changes fast: a steep
+    # backbone, not a tongue (there the period is locked) — it was jumped, landing on an ω = 0.43 or 0.87 orbit
+    for stop in (2.0, 3.0):
+        branch = lindstedt.continue_nnm(SYSTEM, 2, start=0.5, stop=stop, parameter="modal_amplitude", epsilon=EPSILON)
+        assert branch.success and branch.jumps == () and len(branch.contact_changes) == 1, branch.stop_reason
+        end = branch.points[-1]
+        assert end.frequency > 1.62 and end.n_switches == 4 and end.mode_share > 0.9
+        alone = lindstedt.nnm_point(SYSTEM, EPSILON, 2, modal_amplitude=stop)
+        assert alone.success and alone.frequency == pytest.approx(end.frequency, rel=1e-10, abs=0), alone.message
+        y0 = np.r_[end.release_position, end.release_velocity]
+        closure = float(_distance(_integrate(y0, end.period, 1e-12).y[:, -1], y0, end.frequency)[0])
+        assert closure < 1e-9

@@ -31,7 +31,8 @@ how they step:
     resonance tongue of mode k — the arc turns vertical (λ stops advancing)
     *towards mode k* and climbing it stalls the continuation (the 20-dof chain
     with three springs did so at ε ≈ 0.011 after 330 points).  When the
-    tangent's λ-component collapses and mode k dominates it, the method *jumps*:
+    tangent's λ-component collapses, mode k dominates it and the period is locked
+    (its component of the tangent small), the method *jumps*:
     it solves at fixed λ further and further beyond (predictor: the last
     regular tangent) and lands on the first regular point of mode j
     (``NNMBranch.jumps``, the stop reason names what each jump crossed).  If no
@@ -348,8 +349,8 @@ def continue_nnm(
         refined to 1/8 of the initial step, then the branch is followed through
         that corner (contact onset: the backbone turns steep there).
         Where the branch turns vertical towards another mode (its tangent's
-        λ-component falls below half its recent level and another mode
-        dominates the tangent: an internal-resonance tongue), the method jumps
+        λ-component falls below half its recent level, another mode dominates
+        the tangent and the period is locked: an internal-resonance tongue), the method jumps
         across at fixed λ to the next regular point of mode j (up to 8 landings,
         distances growing ×1.5 from the recent step's λ-extent, at most a
         quarter of the range; ``NNMBranch.jumps``); if none lands, the turn is
@@ -644,6 +645,9 @@ _JUMP_GROWTH = 1.5
 _LANDING_RATIO = 0.5
 #: the scaled first correction of the corrector aimed at by the step control (the predictor's error)
 _PREDICTOR_ERROR = 2e-3
+#: in a resonance tongue the period is locked: the scaled period component of the tangent is at most this share of
+#: the state's (0.03–0.05 on the tongues of the 8-mass chain; 0.5–0.6 on the steep backbone after a contact onset)
+_LOCKED_RATIO = 0.2
 #: where the springs switching along the orbit change, the step is refined to the initial one / 2**this
 _CONTACT_REFINEMENT = 3
 #: the longest jump, as a fraction of the range |stop − start|
@@ -720,8 +724,14 @@ class _Arclength(_Stepper):
         return level if level > _REGULAR_MIN else None
 
     def other_mode(self, tangent: np.ndarray, scales: np.ndarray) -> int | None:
-        """The mode (1-based) dominating the tangent's change of state when it is not mode j, else None."""
+        """The mode (1-based) dominating the tangent's change of state when it is not mode j and the period is
+        locked (a resonance tongue: the scaled period component of the tangent at most ``_LOCKED_RATIO`` of the
+        state's), else None — a tangent turning to another mode while the period changes fast is a steep part of
+        the backbone (as after a contact onset in the modal-amplitude parametrisation)."""
         problem = self.problem
+        _, _, period = problem.split(tangent[:-1])
+        if abs(period) > _LOCKED_RATIO * float(np.linalg.norm(tangent[:problem.n_unknowns - 1])):
+            return None
         x, v, _ = problem.split(tangent[:-1] * scales[:-1])
         frequencies = problem.system.modes().frequencies
         energy = (frequencies * (problem.projector @ x)) ** 2 + (problem.projector @ v) ** 2
