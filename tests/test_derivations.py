@@ -307,7 +307,7 @@ def test_every_script_runs_from_any_directory_and_prints_its_coefficients_checks
         cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
     for name, process in processes.items():
-        stdout, stderr = process.communicate(timeout=120)
+        stdout, stderr = process.communicate(timeout=600)  # a hang guard: all scripts together take ~10 s
         assert process.returncode == 0, (name, stderr)
         expected = [tmp_path / name / f"{name}.tex", tmp_path / name / f"{name}.json"]
         assert [Path(line.split("wrote ", 1)[1]) for line in stdout.splitlines() if line.startswith("  wrote ")] == expected
@@ -315,7 +315,7 @@ def test_every_script_runs_from_any_directory_and_prints_its_coefficients_checks
         assert "DISAGREES" not in stdout and "agrees" in stdout
         assert "omega" in json.loads(expected[1].read_text(encoding="utf-8"))
         assert_valid_latex(expected[0].read_text(encoding="utf-8"))
-    _, stderr = failing.communicate(timeout=120)
+    _, stderr = failing.communicate(timeout=600)
     assert failing.returncode == 2 and stderr.startswith("error:") and not (tmp_path / "bad").exists()
 
 
