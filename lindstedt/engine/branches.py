@@ -53,7 +53,6 @@ Coefficients live in any sympy field: exact (``QQ``, ``QQ(π, κ, β, …)``) or
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
 from typing import Any, Sequence
 
 import mpmath
@@ -61,7 +60,7 @@ import numpy as np
 
 from .._errors import ResonanceError
 from ..algebra.branch import Branch, EvaluationPoint
-from .._precision import locked
+from .._precision import cached_property, locked
 from .orders import LazyOrders, shift_powers
 from .stretched import FloatArc
 

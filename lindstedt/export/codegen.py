@@ -456,6 +456,7 @@ def stable_function(expression: sympy.Expr, symbol: sympy.Symbol) -> Callable[[A
     return namespace["lindstedt_stable"]
 
 
+@locked  # around the cache: threads asking at once for one coefficient derive it once
 @functools.lru_cache(maxsize=32)
 def _stable_coefficient_cached(expression: sympy.Expr, x: sympy.Symbol) -> StableCoefficient | None:
     return stable_coefficient(expression, x)

@@ -19,7 +19,7 @@ import numpy as np
 import sympy
 from gmpy2 import mpq as Fraction  # exact rationals, several times faster than fractions.Fraction
 
-from .._precision import locked, workdps
+from .._precision import LOCK, locked, workdps, workprec
 
 __all__ = ["SERIES_TARGET", "BoundedFamily", "Patch", "StableCoefficient", "compile_family", "stable_coefficient"]
 
@@ -784,11 +784,37 @@ class _FamilyBuilder:
         return {key: value for key, value in terms.items() if value != 0} or {(0,) * width: mpmath.mpf(0)}
 
 
-@locked
+#: Compiled families by (expressions, symbols), oldest first (guarded by the precision lock).
+_FAMILIES: dict[tuple, BoundedFamily | None] = {}
+_FAMILY_MEMORY = 64
+
+
+def forget_families() -> None:
+    """Drop the remembered families (:func:`lindstedt.clear_cache`)."""
+    with LOCK:
+        _FAMILIES.clear()
+
+
 def compile_family(expressions: list[sympy.Expr], symbols: tuple[sympy.Symbol, ...]) -> BoundedFamily | None:
     """A :class:`BoundedFamily` for ``expressions`` in ``symbols``, or None if one of them is outside the
     representation (see the comment block above: polynomials over monomial or polynomial denominators in the
-    symbols and in roots and elementary functions of such expressions)."""
+    symbols and in roots and elementary functions of such expressions).
+
+    The constants are folded in double precision whatever mpmath's precision outside, under the lock that
+    guards it: the same family on every thread.  Families are remembered (the last :data:`_FAMILY_MEMORY`),
+    so threads that ask for one at once compile it once."""
+    key = (tuple(expressions), tuple(symbols))
+    with workprec(53):
+        family = _FAMILIES.pop(key, _FAMILIES)  # the dict itself marks a miss (None is a valid entry)
+        if family is _FAMILIES:
+            family = _compile_family(expressions, symbols)
+        _FAMILIES[key] = family  # most recent last
+        while len(_FAMILIES) > _FAMILY_MEMORY:
+            del _FAMILIES[next(iter(_FAMILIES))]
+        return family
+
+
+def _compile_family(expressions: list[sympy.Expr], symbols: tuple[sympy.Symbol, ...]) -> BoundedFamily | None:
     builder = _FamilyBuilder(tuple(symbols))
     parts = []
     try:

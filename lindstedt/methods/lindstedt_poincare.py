@@ -14,12 +14,14 @@ from collections import OrderedDict
 from typing import Any, Callable, Hashable, Mapping, NamedTuple
 
 from .._errors import OrderError, ProblemError
+from .._precision import LOCK
 from ..results.expansion import Expansion
 from ..problems.oscillator import DISPLACEMENT, Oscillator
 from ..problems.piecewise_linear import has_non_polynomial_law
 from ..engine.branches import BranchHierarchy
 from ..engine.contact import contact_normal_form
 from ..engine.smooth import MAX_ORDER, SmoothHierarchy, normal_form
+from ..export.stable import forget_families
 
 __all__ = ["CACHE_MAXSIZE", "CacheInfo", "LindstedtPoincare", "cache_info", "clear_cache", "expand", "validate_order"]
 
@@ -53,19 +55,33 @@ class _HierarchyCache:
         self.misses = 0
 
     def get(self, key: Hashable, build: Callable[[], Any]) -> Any:
-        with self._lock:
-            if key in self._entries:
-                self._entries.move_to_end(key)
-                self.hits += 1
-                return self._entries[key]
-            self.misses += 1
-        value = build()  # outside the lock: building may raise, and must not block other problems
-        with self._lock:
-            value = self._entries.setdefault(key, value)  # another thread may have built it meanwhile
-            self._entries.move_to_end(key)
-            while len(self._entries) > self.maxsize:
-                self._entries.popitem(last=False)
+        value = self._lookup(key)
+        if value is not None:
+            return value
+        # A miss is built under the derivation lock (building is GIL-bound anyway): threads asking for the
+        # same new problem build it once and the others find it.  The cache's own lock is never held while
+        # waiting for that one (no lock-order deadlock).
+        with LOCK:
+            value = self._lookup(key)
+            if value is not None:
+                return value
+            with self._lock:
+                self.misses += 1
+            value = build()
+            with self._lock:
+                self._entries[key] = value
+                while len(self._entries) > self.maxsize:
+                    self._entries.popitem(last=False)
         return value
+
+    def _lookup(self, key: Hashable) -> Any:
+        """The entry (counted as a hit), or None."""
+        with self._lock:
+            if key not in self._entries:
+                return None
+            self._entries.move_to_end(key)
+            self.hits += 1
+            return self._entries[key]
 
     def clear(self) -> None:
         with self._lock:
@@ -81,7 +97,7 @@ _CACHE = _HierarchyCache(CACHE_MAXSIZE)
 
 
 def clear_cache() -> None:
-    """Forget every cached hierarchy (and reset the statistics of :func:`cache_info`).
+    """Forget every cached hierarchy and compiled evaluator family (and reset the statistics of :func:`cache_info`).
 
     ``lindstedt.expand`` keeps the hierarchies of the last :data:`CACHE_MAXSIZE`
     (64) problems, so that asking again, or to a higher order, reuses the work
@@ -103,6 +119,7 @@ def clear_cache() -> None:
     0
     """
     _CACHE.clear()
+    forget_families()
 
 
 def cache_info() -> CacheInfo:

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from functools import cached_property
 from typing import Any, Iterable, Mapping, NamedTuple, Sequence
 
 import mpmath
@@ -32,7 +31,7 @@ import sympy
 
 from .._errors import ProblemError
 from .parsing import parse_real
-from .._precision import locked, workdps, workprec
+from .._precision import cached_property, locked, workdps, workprec
 
 __all__ = ["UnilateralSystem", "Modes", "OneDofUnilateral"]
 

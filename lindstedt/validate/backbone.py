@@ -23,7 +23,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from .._errors import ProblemError
-from .._sweep import MPMATH_LOCK, sweep_map
+from .._sweep import sweep_map
 from ..export.json import JsonExport
 from ..problems.oscillator import Oscillator
 
@@ -102,14 +102,10 @@ class Backbone(JsonExport):
 
 def _amplitude_task(a0: float, *, f: Any, order: int, omega0: Any, params: Any, epsilon: float, reference: bool,
                     precision: int) -> tuple[list[float] | None, float, float, str, str]:
-    """(ω_1 … ω_N truncated at ε, exact ω, its estimate, failure text, validity warning) at one amplitude (picklable)."""
-    with MPMATH_LOCK:  # the quadrature and the engine set mpmath's process-wide precision
-        return _amplitude_outcome(a0, f=f, order=order, omega0=omega0, params=params, epsilon=epsilon,
-                                  reference=reference, precision=precision)
+    """(ω_1 … ω_N truncated at ε, exact ω, its estimate, failure text, validity warning) at one amplitude (picklable).
 
-
-def _amplitude_outcome(a0: float, *, f: Any, order: int, omega0: Any, params: Any, epsilon: float, reference: bool,
-                       precision: int) -> tuple[list[float] | None, float, float, str, str]:
+    Safe on threads: the engine and the quadrature hold :data:`lindstedt._sweep.MPMATH_LOCK` where they use mpmath.
+    """
     from .._errors import LindstedtError
     from ..methods.lindstedt_poincare import expand
     from ..results.accuracy import ExpansionValidityWarning

@@ -49,7 +49,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from .._errors import ProblemError
-from .._sweep import MPMATH_LOCK, sweep_map
+from .._sweep import sweep_map
 from ..export.json import JsonExport
 from ..results.accuracy import ExpansionValidityWarning
 from ..problems.oscillator import Oscillator
@@ -340,8 +340,7 @@ def _error_task(window: tuple[float, float], *, expansion: Expansion, omega0: fl
                 options: dict[str, Any]) -> ExpansionError:
     """:func:`expansion_error` over ``window = (ε, t_end)`` (module level: picklable for process pools)."""
     eps, t_end = window
-    with MPMATH_LOCK:  # exact repairs of the compiled expansion set mpmath's process-wide precision
-        return expansion_error(expansion, eps, t_end, _default_samples(t_end, omega0, samples_per_period), **options)
+    return expansion_error(expansion, eps, t_end, _default_samples(t_end, omega0, samples_per_period), **options)
 
 
 def _validity_task(window: tuple[float, float, float], *, period: float, **run: Any) -> tuple[float | None, float, list[ExpansionError]]:
