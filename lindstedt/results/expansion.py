@@ -60,7 +60,7 @@ import math
 import re
 import warnings
 from dataclasses import dataclass, field
-from functools import cached_property
+from .._precision import cached_property, locked, workdps
 from collections import OrderedDict
 from typing import Any, Callable, Mapping, NamedTuple, Sequence
 
@@ -79,7 +79,8 @@ from .accuracy import (
     series_warning,
     series_warning_mask,
 )
-from .assumptions import DerivationAssumptions, shown_values
+from .assumptions import DerivationAssumptions, check_names, shown_values
+from .orbit_range import OrbitRange, orbit_range, range_function
 from .._errors import OrderError, ParameterError, ProblemError, UnsupportedNonlinearityError
 from ..export.codegen import stable_function
 from ..export.stable import compile_family
@@ -204,12 +205,14 @@ def _assumption_latex(text: str, symbols: Mapping[str, sympy.Symbol]) -> str:
     return latex
 
 
+@locked
 def _as_float(expression: sympy.Expr) -> float | None:
     if expression.free_symbols:
         return None
     return float(expression)
 
 
+@locked  # sympy's evalf of acos, … sets mpmath's process-wide precision
 def _to_float(expression: sympy.Expr) -> float:
     """float() of a numeric expression; NaN where it is not a finite real number (checked by :func:`_finite`)."""
     try:
@@ -396,7 +399,7 @@ def _phase_coefficients(expansion: "Expansion", highest: int) -> tuple[sympy.Exp
             arc = next(item for item in expansion.stretched_arcs if item.side == ("release" if piece == 0 else "far"))
             if problem.free_symbols:
                 raise UnsupportedNonlinearityError("an orbit that starts on a stretched contact arc needs numeric omega0 and parameters")
-            with mpmath.workdps(arc.digits + 10):
+            with workdps(arc.digits + 10):
                 numeric_angle = mpmath.mpf(sympy.N(angle, arc.digits + 10))
 
             def arc_derivative(k: int, m: int) -> sympy.Expr:
@@ -778,6 +781,7 @@ class Expansion:
         """
         key = ("substitution", self._values_key(values))
         if key not in self._float_cache:
+            check_names(values or {}, self._argument_names)
             self._float_cache[key] = self._assumptions.check(self.problem.numeric_substitution(values))
         return self._float_cache[key]
 
@@ -835,7 +839,7 @@ class Expansion:
         coefficients = self._omega_values(last, point)
         points = self._gauge_values(epsilon)
         result = _horner(points, coefficients)
-        message = self._series_message(coefficients, last, points, point)
+        message = self._range_message(epsilon, point, values) or self._series_message(coefficients, last, points, point)
         if message:
             warnings.warn(ExpansionValidityWarning(message), stacklevel=4)
         if values is None and order is None and not point.arrays and self._steps == 1 and not message:
@@ -847,7 +851,7 @@ class Expansion:
         coefficients = self._frequency_coefficients(last + 1, values)
         points = self._gauge_values(epsilon)
         result = np.polynomial.polynomial.polyval(points, coefficients[: last + 1])
-        message = series_warning(coefficients, last, points, str(self.gauge))
+        message = self._range_message(epsilon, None, values) or series_warning(coefficients, last, points, str(self.gauge))
         if message:
             warnings.warn(ExpansionValidityWarning(message), stacklevel=4)
         return float(result) if np.ndim(result) == 0 else result
@@ -892,7 +896,11 @@ class Expansion:
             coefficient = self._frequency_coefficients(last + 1, values)[last + 1]
         else:  # vectorised over parameter arrays too
             coefficient = self._omega_values(last + 1, point)[last + 1]
-        return np.abs(coefficient * self._gauge_values(epsilon) ** (last + 1))
+        estimate = np.abs(coefficient * self._gauge_values(epsilon) ** (last + 1))
+        message = self._range_message(epsilon, point, values)
+        if message:
+            warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
+        return estimate
 
     def displacement_error_estimate(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None = None) -> np.ndarray:
         """Estimated error of :meth:`displacement` at ``t`` (vectorised): the phase drift ``|a0| δω t``, δω the terms of ω
@@ -909,6 +917,9 @@ class Expansion:
         scale, amplitude, branches = self._float_branches(values)
         last = self._steps * self.order
         eta = float(self._gauge_values(float(epsilon)))
+        message = self._range_message(epsilon, None, values)
+        if message:
+            warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
         # The displacement pairs v_0 … v_n with ω through ω_{n+1}: its phase drifts with the next terms, one power of ε
         # of them (two in the gauge ε^{1/2}, whose analytic and non-analytic terms interleave).
         coefficients = self._frequency_coefficients(last + 1 + self._steps, values)
@@ -916,6 +927,78 @@ class Expansion:
         scaled = abs(scale) ** (1 / self._steps) * eta  # η̂, the normalised gauge of the waveforms
         neglected = abs(amplitude) * scaled ** (last + 1) * branch_bound(branches.terms[last], branches.shifts[0])
         return displacement_error(amplitude, frequency_error, np.asarray(t, dtype=float), neglected)
+
+    def epsilon_range(self, values: Mapping[Any, Any] | None = None) -> OrbitRange | None:
+        """How far in ε the derivation holds at these parameter values (one point): the open interval
+        ``(lower, upper)`` on which the true orbit through the release state keeps the contact regime the
+        expansion was derived for, and ``radius``, the distance to the nearest singularity of ω(ε) the law gives
+        (see :mod:`lindstedt.results.orbit_range`).
+
+        None where it is not computed: non-polynomial pieces (fractional or analytic contact laws, smooth f
+        such as sin u), a release shifted by ε a1, and the "harmonic" normalization.
+
+        The evaluators (:meth:`frequency`, :meth:`displacement`, :meth:`velocity`, the error estimates) raise
+        a :class:`~lindstedt.ParameterError` at an ε where no periodic orbit exists (the motion escapes over a
+        separatrix, a contact state with ω0² + ε·slope ≤ 0 it cannot leave, the release point an equilibrium)
+        and warn (:class:`ExpansionValidityWarning`, naming the bound) at an ε outside ``(lower, upper)`` or at
+        ``|ε| >= radius``.
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> duffing = lindstedt.expand("u**3", order=2, a0=1, omega0=1)
+        >>> bounds = duffing.epsilon_range()          # softening past eps a0**2 = -omega0**2: the separatrix
+        >>> round(bounds.lower, 12), bounds.upper, round(bounds.radius, 12)
+        (-1.0, inf, 1.0)
+        >>> lindstedt.expand("Max(0, u + 3/2)", order=2, a0=1, omega0=1).epsilon_range().upper   # leaves contact
+        0.2
+        """
+        point = self._read(values)
+        if point is not None and point.shape:
+            raise ParameterError("epsilon_range takes one parameter point: give scalar values")
+        return self._range_at(self._range_arguments(point, values))
+
+    @cached_property
+    def _range_source(self) -> Callable[..., tuple[Any, ...]] | None:
+        return range_function(self.problem, self._symbols)
+
+    def _range_arguments(self, point: "_Point | None", values: Mapping[Any, Any] | None) -> tuple[float, ...]:
+        if point is not None:
+            return tuple(float(value) for value in point.arrays)
+        substitution = self._substitution(values)
+        return tuple(float(substitution[symbol]) for symbol in self._symbols)
+
+    def _range_at(self, arguments: tuple[float, ...]) -> OrbitRange | None:
+        """The :class:`OrbitRange` at float parameter values (cached for the last _MEMORY points)."""
+        source = self._range_source
+        if source is None:
+            return None
+        memory = self._float_cache.setdefault("ranges", OrderedDict())
+        if arguments not in memory:
+            memory[arguments] = orbit_range(*source(*arguments), self._steps)
+            if len(memory) > _MEMORY:
+                memory.popitem(last=False)
+        return memory[arguments]
+
+    def _range_message(self, epsilon: Any, point: "_Point | None", values: Mapping[Any, Any] | None) -> str | None:
+        """Raise where no periodic orbit exists at some ε; else the warning for ε outside the derivation's regime
+        or beyond the radius of convergence (see :meth:`epsilon_range`), or None."""
+        if self._range_source is None:
+            return None
+        gauge = self._gauge_text
+        if point is None or not point.shape:
+            bounds = self._range_at(self._range_arguments(point, values))
+            return bounds.judge(epsilon, gauge)
+        arrays = np.broadcast_arrays(np.asarray(epsilon, dtype=float), *[np.asarray(value, dtype=float) for value in point.arrays])
+        columns = np.stack([array.reshape(-1) for array in arrays[1:]], axis=1)
+        epsilons = arrays[0].reshape(-1)
+        unique, inverse = np.unique(columns, axis=0, return_inverse=True)
+        for index, row in enumerate(unique):
+            message = self._range_at(tuple(float(value) for value in row)).judge(epsilons[inverse.reshape(-1) == index], gauge)
+            if message:
+                given = ", ".join(f"{name} = {value:.6g}" for name, value in zip(self._argument_names, row))
+                return f"at {given}: {message}"
+        return None
 
     def _gauge_values(self, epsilon: Any) -> np.ndarray:
         """The gauge at ε (ε itself, or √ε: then ε must not be negative)."""
@@ -993,7 +1076,8 @@ class Expansion:
         eta = self._gauge_values(epsilon)
         times = np.asarray(t, dtype=float)
         frequency = _horner(eta, coefficients)
-        message = self._series_message(coefficients[: last + 1], last, eta, point, coefficients[last + 1])
+        message = self._range_message(epsilon, point, values) or self._series_message(
+            coefficients[: last + 1], last, eta, point, coefficients[last + 1])
         if message is None:
             message = self._drift_message(coefficients, last, eta, times, point)
         if message:
@@ -1019,6 +1103,7 @@ class Expansion:
         scale, amplitude, branches = self._float_branches(values)
         gauge, frequency, message, drift = self._at_epsilon(float(epsilon), values)
         times = np.asarray(t, dtype=float)
+        message = self._range_message(epsilon, None, values) or message
         if message is None:
             message = phase_warning(drift, times)
         if message:
@@ -1063,6 +1148,7 @@ class Expansion:
             if names:
                 self.problem.numeric_substitution(values)  # raises: values needed
             return self._no_parameters
+        check_names(values, names)
         floats: dict[str, Any] = {}
         scalar = True
         for key, value in values.items():
@@ -1384,6 +1470,9 @@ class Expansion:
         else:
             following = float(next_term_bound(coefficients))
         radius = quiet_radius([*coefficients, following], last)
+        bounds = self._range_at(())
+        if bounds is not None:  # strictly inside the orbit's range and the disc of convergence
+            radius = min(radius, bounds.radius, bounds.upper, -bounds.lower) * (1 - 1e-9)
         self.__dict__["_fast_frequency"] = (tuple(float(value) for value in coefficients[::-1]), radius)
         self.__dict__["_fast_frequency_known"] = known
 
@@ -1437,8 +1526,9 @@ class Expansion:
             raise OrderError(f"the amplitude series holds orders up to {self.order}; expand to a higher order")
         return sympy.Add(*[self.amplitude[k] * self.gauge**k for k in range(last + 1)])
 
-    def displacement_expr(self) -> sympy.Expr:
-        """u(t; ε) = Σ_{k≤N} ε^k v_k(ω t + φ(ε)) with ω through ω_{N+1}, as a sympy expression.
+    def displacement_expr(self, derivative: bool = False) -> sympy.Expr:
+        """u(t; ε) = Σ_{k≤N} ε^k v_k(ω t + φ(ε)) with ω through ω_{N+1}, as a sympy expression (its time derivative
+        u'(t) with ``derivative=True``, as :meth:`velocity` evaluates it).
 
         For piecewise-linear f the strained time is folded to [0, π]
         (evenness, 2π-periodicity) and the pieces end at the moving contact
@@ -1452,9 +1542,13 @@ class Expansion:
         frequency = self.frequency_expr(self.order) + self.omega_next * self.gauge ** (self._steps * self.order + 1)
         strained = frequency * TIME + self.phase_expr()
         if not self.is_piecewise:
-            return sympy.Add(*[EPSILON**w.order * w.to_expr(strained) for w in self.waveforms])
+            displacement = sympy.Add(*[EPSILON**w.order * w.to_expr(strained) for w in self.waveforms])
+            return sympy.diff(displacement, TIME) if derivative else displacement
         folded = sympy.Abs(sympy.Mod(strained + sympy.pi, 2 * sympy.pi) - sympy.pi)
         pieces = [sympy.Add(*[self.gauge**w.order * w.branches[p] for w in self.waveforms]) for p in range(len(self.waveforms[0].branches))]
+        if derivative:  # d/dt v(|s|) = ω sign(s) v'(|s|), s the strained time folded to (−π, π]
+            pieces = [frequency * sympy.sign(sympy.Mod(strained + sympy.pi, 2 * sympy.pi) - sympy.pi) * sympy.diff(piece, STRAINED_TIME)
+                      for piece in pieces]
         boundaries = [
             sympy.Add(*[self.gauge**k * self.contact_angle_correction(k)[index] for k in range(1, self._steps * self.order + 1)], angle)
             for index, angle in enumerate(self.contact_angles)
@@ -1472,7 +1566,9 @@ class Expansion:
         """A vectorised numeric function generated through ``sympy.lambdify``.
 
         ``quantity="displacement"`` gives ``u(t, epsilon, *arguments)``;
+        ``quantity="velocity"`` gives ``u'(t, epsilon, *arguments)``;
         ``quantity="frequency"`` gives ``omega(epsilon, *arguments)``.
+        The generated functions do not check ε against the expansion's range (:meth:`epsilon_range`).
 
         Examples
         --------
@@ -1482,11 +1578,12 @@ class Expansion:
         >>> round(float(omega(0.1)), 12)
         1.0366796875
         """
-        if quantity == "displacement":
-            return sympy.lambdify((TIME, EPSILON, *self.arguments), self.displacement_expr(), modules=modules)
+        if quantity in ("displacement", "velocity"):
+            expression = self.displacement_expr(derivative=quantity == "velocity")
+            return sympy.lambdify((TIME, EPSILON, *self.arguments), expression, modules=modules)
         if quantity == "frequency":
             return sympy.lambdify((EPSILON, *self.arguments), self.frequency_expr(), modules=modules)
-        raise ValueError("quantity must be 'displacement' or 'frequency'")
+        raise ProblemError(f"quantity must be 'displacement', 'velocity' or 'frequency', got {quantity!r}")
 
     def to_latex(self, *, waveforms: bool = False) -> str:
         r"""A LaTeX fragment (``align*``): the equation, what the derivation assumed, the ω_k, ω(ε), optionally the v_k.

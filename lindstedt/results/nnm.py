@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import warnings
 from dataclasses import dataclass, field
-from functools import cached_property
+from .._precision import cached_property
 from typing import Any
 
 import mpmath
@@ -25,7 +25,9 @@ from .accuracy import (
     branch_bound,
     displacement_error,
     gauge_values,
+    geometric_tail,
     phase_warning,
+    radius_warning,
     series_warning,
 )
 from ..problems.nnm import NNMProblem
@@ -116,9 +118,10 @@ class NNMExpansion:
         """ω(ε) = Σ_n ω_n η^n (vectorised), η = ε, or ε^{1/2} when ``gauge`` is 2.
 
         Warns (:class:`~lindstedt.ExpansionValidityWarning`) where the series does not
-        converge: its terms grow, or the next term exceeds the whole correction.  The first
-        call derives that next term ω_{n+1} (see :meth:`truncation_error_estimate`); later
-        calls are one polynomial evaluation.
+        converge: its terms grow, the next term exceeds the whole correction, or η is beyond
+        the radius of convergence estimated from the growth of ω_1 … ω_{n+1} (where
+        :meth:`truncation_error_estimate` is infinite).  The first call derives that next term
+        ω_{n+1}; later calls are one polynomial evaluation.
 
         Examples
         --------
@@ -133,22 +136,41 @@ class NNMExpansion:
         True
         """
         eta = self._gauge_values(epsilon)
-        message = series_warning(self._coefficients, len(self.omega) - 1, np.atleast_1d(eta), self._gauge_name)
+        message = self._series_message(eta)
         if message:
             warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
         return np.polynomial.polynomial.polyval(eta, self._known_coefficients)
 
+    def _series_message(self, eta: np.ndarray) -> str | None:
+        last = len(self.omega) - 1
+        return series_warning(self._coefficients, last, np.atleast_1d(eta), self._gauge_name) or radius_warning(
+            self._tail(eta)[1], eta, self._gauge_name, last)
+
+    def _tail(self, eta: Any) -> tuple[np.ndarray, float]:
+        return geometric_tail(self._coefficients, len(self.omega) - 1, eta)
+
     def truncation_error_estimate(self, epsilon: Any) -> Any:
-        """``|ω_{n+1} η^{n+1}|``: the size of the first neglected term of ω(ε) (vectorised).
+        """Estimated |ω(ε) − Σ_{k≤n} ω_k η^k| (vectorised): the first neglected term ``|ω_{n+1} η^{n+1}|`` plus the
+        later ones bounded by a geometric envelope of ω_1 … ω_{n+1}
+        (:func:`lindstedt.results.accuracy.geometric_tail`); +inf beyond the radius of convergence that envelope
+        estimates (:meth:`frequency` warns there).
 
         The first call derives ω_{n+1}: order n + 1 of the hierarchy, which needs every W_{n,k} (O(N²) terms).
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> mode = lindstedt.nnm(lindstedt.UnilateralSystem.one_dof(1, a=1, b=0), mode=1, a0=1, order=2)
+        >>> float(mode.truncation_error_estimate(0.01)) < 1e-6 < float(mode.truncation_error_estimate(0.1))
+        True
         """
-        return np.abs(self._coefficients[-1] * self._gauge_values(epsilon) ** len(self.omega))
+        estimate, _ = self._tail(self._gauge_values(epsilon))
+        return estimate if np.ndim(estimate) else float(estimate)
 
     def displacement_error_estimate(self, t: Any, epsilon: float) -> np.ndarray:
         """Estimated error of :meth:`modal_displacement` at ``t`` (vectorised, the worst modal coordinate): the phase
-        drift ``|a0 ω_{n+1} η^{n+1}| t`` plus the first neglected waveform term (the last kept one times η̂).
-        Derives ω_{n+1} on first use (see :meth:`truncation_error_estimate`).
+        drift ``|a0| δω t`` (δω the frequency's :meth:`truncation_error_estimate`) plus the first neglected waveform
+        term (the last kept one times η̂).  Derives ω_{n+1} on first use.
 
         Examples
         --------
@@ -160,9 +182,8 @@ class NNMExpansion:
         eta = float(self._gauge_values(float(epsilon)))
         lam = float(self.omega[0])
         scaled = eta * (lam * lam) ** (-1 / self.gauge)
-        last = len(self.omega) - 1
         neglected = abs(self.a0) * abs(scaled) ** len(self._float_branches.terms) * self._last_branch_bound
-        frequency_error = abs(self._coefficients[-1]) * abs(eta) ** (last + 1)
+        frequency_error = float(self._tail(eta)[0])
         return displacement_error(self.a0, frequency_error, np.asarray(t, dtype=float), neglected)
 
     @cached_property
@@ -212,9 +233,8 @@ class NNMExpansion:
         times = np.asarray(t, dtype=float)
         epsilons = np.asarray(epsilon, dtype=float)
         eta = self._gauge_values(epsilons)
-        last = len(self.omega) - 1
-        message = series_warning(self._coefficients, last, np.atleast_1d(eta), self._gauge_name) or phase_warning(
-            abs(self._coefficients[-1]) * float(np.max(np.abs(eta), initial=0.0)) ** (last + 1), times
+        message = self._series_message(eta) or phase_warning(
+            float(self._tail(float(np.max(np.abs(eta), initial=0.0)))[0]), times
         )
         if message:
             warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
