@@ -82,7 +82,7 @@ def check_names(values: Mapping[Any, Any], names: Sequence[str]) -> None:
     >>> check_names({"A0": 1}, ("a0", "omega0"))
     Traceback (most recent call last):
     ...
-    lindstedt._errors.ParameterError: unknown parameter 'A0'; did you mean 'a0'? (the free symbols are a0, omega0)
+    lindstedt._errors.ParameterError: unknown parameter 'A0'; did you mean 'a0'? (the problem does not have it as a free symbol; its free symbols are a0, omega0)
     """
     for key in values:
         name = key.name if isinstance(key, sympy.Symbol) else str(key)
@@ -91,8 +91,8 @@ def check_names(values: Mapping[Any, Any], names: Sequence[str]) -> None:
         close = difflib.get_close_matches(name, names, n=1, cutoff=0.5) or [
             candidate for candidate in names if candidate.lower() == name.lower()]
         hint = f"; did you mean {close[0]!r}?" if close else ""
-        free = f"(the free symbols are {', '.join(names)})" if names else "(this result has no free symbols: give no values)"
-        raise ParameterError(f"unknown parameter {name!r}{hint} {free}")
+        free = f"its free symbols are {', '.join(names)}" if names else "it has none: give no values"
+        raise ParameterError(f"unknown parameter {name!r}{hint} (the problem does not have it as a free symbol; {free})")
 
 
 _POSITIVE, _NEGATIVE, _ZERO, _NONZERO = frozenset({1}), frozenset({-1}), frozenset({0}), frozenset({-1, 1})
