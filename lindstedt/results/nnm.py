@@ -150,9 +150,8 @@ class NNMExpansion:
         return geometric_tail(self._coefficients, len(self.omega) - 1, eta)
 
     def truncation_error_estimate(self, epsilon: Any) -> Any:
-        """Estimated |ω(ε) − Σ_{k≤n} ω_k η^k| (vectorised): the first neglected term ``|ω_{n+1} η^{n+1}|`` plus the
-        later ones bounded by a geometric envelope of ω_1 … ω_{n+1}
-        (:func:`lindstedt.results.accuracy.geometric_tail`); +inf beyond the radius of convergence that envelope
+        """Estimated ``|ω(ε) − Σ_{k≤n} ω_k η^k|`` (vectorised): the first neglected term ``|ω_{n+1} η^{n+1}|`` plus
+        the later ones bounded by a geometric envelope of ω_1 … ω_{n+1}; +inf beyond the radius of convergence that envelope
         estimates (:meth:`frequency` warns there).
 
         The first call derives ω_{n+1}: order n + 1 of the hierarchy, which needs every W_{n,k} (O(N²) terms).
