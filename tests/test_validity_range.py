@@ -18,7 +18,8 @@ import sympy
 
 import lindstedt
 from lindstedt import ExpansionValidityWarning, ParameterError, ProblemError, UnilateralSystem
-from lindstedt.references import conservative_frequency, duffing_exact_frequency, piecewise_linear_exact_frequency
+from lindstedt.references import (conservative_frequency, conservative_period, duffing_exact_frequency,
+                                  piecewise_linear_exact_frequency)
 
 U = sympy.Symbol("u")
 
@@ -246,3 +247,161 @@ def test_unknown_value_names_are_named_with_a_suggestion():
         lindstedt.expand("u**3", order=2).frequency(0.1, values={"A0": 1, "omega0": 1})
     with pytest.raises(ParameterError, match="unknown parameter 'A0'"):
         lindstedt.expand("u**3", order=2, a0=1, omega0=1).frequency(0.1, values={"A0": 1.0})
+
+
+# -- laws that are not polynomials: smooth analytic f, fractional (Hertz) and analytic contact laws -----------------
+#
+# References: the bound in closed form where the event has one (the release point an equilibrium: ω0² a0 + ε f(a0) = 0;
+# the orbit's energy at the hump V(0) = 0 of an odd law: E(ε) = 0), the exact flow integrated by DOP853 (rtol 1e-12)
+# just inside and just outside the bound, and the energy-integral quadrature (lindstedt.references).
+
+def _flow(f, epsilon: float, u0: float, v0: float = 0.0, horizon: float = 60.0) -> dict:
+    """u'' + u + ε f(u) = 0 from (u0, v0) by DOP853 (rtol = atol = 1e-12) until t = horizon or |u| = 50 (escape): the
+    range of u, whether it escaped, and, for a release at rest, the closure error of the return to (u0, 0): the
+    smallest |u − u0| where the velocity vanishes again (inf if it never does)."""
+    from scipy.integrate import solve_ivp
+
+    def rhs(t, y):
+        return [y[1], -y[0] - epsilon * f(y[0])]
+
+    def away(t, y):
+        return abs(y[0]) - 50.0
+
+    away.terminal = True
+
+    def turn(t, y):
+        return y[1]
+
+    run = solve_ivp(rhs, (0.0, horizon), [u0, v0], method="DOP853", rtol=1e-12, atol=1e-12, events=(away, turn), dense_output=True)
+    assert run.status >= 0, run.message
+    u = run.sol(np.linspace(0.0, run.t[-1], 20001))[0]
+    turns = run.y_events[1][run.t_events[1] > 1e-6, 0]
+    closure = float(np.min(np.abs(turns - u0), initial=math.inf)) if v0 == 0 else 0.0
+    return {"escaped": len(run.t_events[0]) > 0, "low": float(u.min()), "high": float(u.max()), "closure": closure}
+
+
+_HERTZ = sympy.Max(0, U) ** sympy.Rational(3, 2)
+_HERTZ_GAP = sympy.Max(0, U - sympy.Rational(1, 2)) ** sympy.Rational(3, 2)
+
+# (law, its sympy expression, its float function, a0, side, bound in closed form, what happens past it)
+_SEPARATRICES = [
+    ("sin(u)", sympy.sin(U), math.sin, 1, "lower", -1 / (2 * (1 - math.cos(1))), "well"),
+    ("u/(1 + u**2)", U / (1 + U**2), lambda u: u / (1 + u * u), 1, "lower", -1 / math.log(2), "well"),
+    ("tanh(u)", sympy.tanh(U), math.tanh, 1, "lower", -1 / (2 * math.log(math.cosh(1))), "well"),
+    ("exp(u) - 1", sympy.exp(U) - 1, lambda u: math.exp(min(u, 700.0)) - 1, 1, "lower", -1 / (math.e - 1), "escape"),
+    ("Max(0, u)**(3/2)", _HERTZ, lambda u: max(u, 0.0) ** 1.5, 1, "lower", -1.0, "escape"),
+    ("Max(0, u - 1/2)**(3/2)", _HERTZ_GAP, lambda u: max(u - 0.5, 0.0) ** 1.5, 1, "lower", -(2**1.5), "escape"),
+    ("-u + u**3", -U + U**3, lambda u: -u + u**3, sympy.Rational(6, 5), "upper", 25 / 7, "well"),
+    ("-u + u**3", -U + U**3, lambda u: -u + u**3, 1, "upper", 2.0, "well"),
+]
+
+
+@pytest.mark.parametrize("text, expression, function, a0, side, closed_form, beyond", _SEPARATRICES,
+                         ids=[f"{case[0]}-a0={case[3]}" for case in _SEPARATRICES])
+def test_separatrix_of_a_law_matches_its_closed_form_and_the_flow(text, expression, function, a0, side, closed_form, beyond):
+    """sin, u/(1+u²), tanh, a0 = 1: for ε < −1/f'(0) the origin is a hump of V with V(0) = 0; the orbit through a0 spans
+    it while E(ε) = a0²/2 + ε F(a0) > 0 and is confined to the well u > 0 once E < 0: the bound is E = 0,
+    ε = −a0²/(2 F(a0)). exp(u) − 1 and the Hertz laws: the release point becomes the hump, 1 + ε f(1) = 0, and the
+    motion escapes. −u + u³: for ε > 1 the origin is a hump; E = 0 at ε = 25/7 (a0 = 6/5) and 2 (a0 = 1) — the
+    previous hump count called the first bounded at 0 and missed the second. The flow is periodic across 0 just
+    inside and escapes or stays in one well just outside; the quadrature succeeds inside, fails (escape) or finds the
+    orbit of the one well (at most 3/4 of the period) outside.  Periodic: the flow returns to (a0, 0) within 1e-6 (DOP853
+    loses digits where f'' is singular, u = b of the Hertz laws, and near the separatrix; another regime is O(1) off)."""
+    bounds = lindstedt.expand(text, order=2, a0=a0, omega0=1).epsilon_range()
+    bound = getattr(bounds, side)
+    assert bound == pytest.approx(closed_form, rel=1e-12)
+    assert bounds.radius == min(abs(bounds.lower), abs(bounds.upper))  # the nearest real singularity
+    a0 = float(a0)
+    inside, outside = _flow(function, bound * (1 - 1e-3), a0), _flow(function, bound * (1 + 1e-3), a0)
+    assert not inside["escaped"] and inside["low"] < 0 < inside["high"] and inside["closure"] < 1e-6, inside
+    period_inside, error = conservative_period(expression, sympy.Rational(bound * (1 - 1e-3)), a0=a0, precision=15)
+    assert float(error) < 1e-10
+    if beyond == "escape":
+        assert outside["escaped"]
+        with pytest.raises(lindstedt.ConvergenceError):
+            conservative_period(expression, sympy.Rational(bound * (1 + 1e-3)), a0=a0, precision=15)
+        assert isinstance(bounds.state(bound * 1.01), str)
+    else:
+        assert not outside["escaped"] and outside["low"] > 0 and outside["closure"] < 1e-6, outside
+        period_outside, _ = conservative_period(expression, sympy.Rational(bound * (1 + 1e-3)), a0=a0, precision=15)
+        assert period_outside < 0.75 * period_inside
+        assert not isinstance(bounds.state(bound * 1.01), str)
+
+
+def test_pendulum_law_past_its_separatrix_warns_naming_the_hump():
+    """The brief's case: sin(u), a0 = 1, ε = −1.5 returned a number silently.  The origin has been a hump since
+    ε = −1; the orbit through 1 leaves it at ε = −1/(2(1 − cos 1)) ≈ −1.08767 and oscillates in the well u > 0 —
+    a periodic orbit, another one: a warning naming the bound and the hump, and the value is not its frequency
+    (the quadrature's)."""
+    expansion = lindstedt.expand("sin(u)", order=4, a0=1, omega0=1)
+    value, messages = _caught(lambda: expansion.frequency(-1.5))
+    assert len(messages) == 1 and "eps = -1.08767 " in messages[0] and "u = 0 " in messages[0] and "separatrix" in messages[0]
+    exact, error = conservative_frequency(sympy.sin(U), "-3/2", a0=1, precision=15)
+    assert abs(value - float(exact)) > 0.1 > float(error)
+    flow = _flow(math.sin, -1.5, 1.0)
+    assert flow["low"] > 0 and flow["closure"] < 1e-8  # periodic, in one well
+
+
+def test_pendulum_law_with_a_large_release_meets_a_new_hump_at_positive_eps():
+    """sin(u), a0 = 5: for ε > 4.6033 (the minimum of −u/sin u on (π, 2π)) u + ε sin u = 0 has two more roots on each
+    side; the orbit through 5 meets the hump among them at ε ≈ 4.7533 and from there on stays in the new well.
+    Reference: the two equations u + ε sin u = 0, V(u) = E(ε) solved by mpmath.findroot at 30 digits, and the flow
+    (the orbit reaches −5 just inside, stays above 4 just outside)."""
+    import mpmath
+
+    bounds = lindstedt.expand("sin(u)", order=2, a0=5, omega0=1).epsilon_range()
+    with mpmath.workdps(30):
+        root = mpmath.findroot(lambda u, e: [u + e * mpmath.sin(u),
+                                             u**2 / 2 + e * (1 - mpmath.cos(u)) - 12.5 - e * (1 - mpmath.cos(5))], (4.25, 4.75))
+    assert bounds.upper == pytest.approx(float(root[1]), rel=1e-12)
+    assert "u = 4.24629" in bounds.upper_reason and f"{float(root[0]):.6g}" == "4.24629"
+    assert bounds.lower == pytest.approx(-12.5 / (1 - math.cos(5)), rel=1e-12)  # E = 0 = V(0), the origin's hump
+    inside, outside = _flow(math.sin, bounds.upper * (1 - 1e-3), 5.0), _flow(math.sin, bounds.upper * (1 + 1e-3), 5.0)
+    assert inside["low"] < -4.9 and inside["closure"] < 1e-8
+    assert outside["low"] > 4 and outside["closure"] < 1e-8
+
+
+def test_release_with_velocity_on_an_analytic_law():
+    """sin(u), u(0) = 1, u'(0) = 1/2: E(ε) = 5/8 + ε (1 − cos 1) vanishes, V(0) = 0 (a hump for ε < −1), at
+    ε = −5/(8(1 − cos 1)); the flow crosses 0 just inside and not just outside."""
+    bounds = lindstedt.expand("sin(u)", order=2, u0=1, v0="1/2", omega0=1).epsilon_range()
+    assert bounds.lower == pytest.approx(-5 / (8 * (1 - math.cos(1))), rel=1e-12)
+    inside = _flow(math.sin, bounds.lower * (1 - 1e-3), 1.0, 0.5)
+    outside = _flow(math.sin, bounds.lower * (1 + 1e-3), 1.0, 0.5)
+    assert inside["low"] < 0 < outside["low"]
+
+
+@pytest.mark.parametrize("text, expression, a0, epsilons", [
+    ("sin(u)", sympy.sin(U), 1, (-0.5, 0.3)),
+    ("tanh(u)", sympy.tanh(U), 1, (-0.5, 0.3)),
+    ("Max(0, u)**(3/2)", _HERTZ, 1, (-0.5, 0.5)),
+    ("Max(0, u - 1/2)*exp(u)", sympy.Max(0, U - sympy.Rational(1, 2)) * sympy.exp(U), 1, (-0.2, 0.2)),
+    ("-u + u**3", -U + U**3, sympy.Rational(6, 5), (0.1, -0.1)),  # the hump count warned at every eps > 0 here
+])
+def test_inside_the_range_the_value_is_silent_and_right(text, expression, a0, epsilons):
+    expansion = lindstedt.expand(text, order=4, a0=a0, omega0=1)
+    for epsilon in epsilons:
+        value, messages = _caught(lambda: expansion.frequency(epsilon))
+        exact, error = conservative_frequency(expression, sympy.Rational(epsilon), a0=a0, precision=15)
+        assert messages == [], (epsilon, messages)
+        assert abs(value - float(exact)) < 2e-3, (epsilon, value, exact)  # order 4; the other orbits are >= 0.1 away
+        assert float(error) < 1e-10
+
+
+@pytest.mark.parametrize("text, epsilon", [("Max(0, u)**(3/2)", -1.5), ("Max(0, u - 1/2)**(3/2)", -3.0), ("exp(u) - 1", -1.0)])
+def test_escape_past_a_contact_law_losing_its_stiffness_is_refused(text, epsilon):
+    """Hertz with ε < 0: the contact force ε (u − b)^{3/2} overcomes the linear spring far out, and the release point is
+    past that hump once ω0² a0 + ε f(a0) < 0 (ε < −1 for b = 0, ε < −2^{3/2} for b = 1/2; ε < −1/(e − 1) for
+    exp(u) − 1): the motion escapes (the flow and the quadrature confirm it at 1.001 times the bound, see above)."""
+    expansion = lindstedt.expand(text, order=3, a0=1, omega0=1)
+    with pytest.raises(ParameterError, match=f"no periodic orbit at eps = {epsilon:g}.*escapes up"):
+        expansion.frequency(epsilon)
+    with pytest.raises(ParameterError, match="no periodic orbit"):
+        expansion.displacement(np.array([0.0, 1.0]), epsilon)
+
+
+def test_normalizations_without_a_fixed_release_are_left_to_the_series_check():
+    """The 'harmonic' normalization (the release point is a result, a series in ε) and a release shifted by ε a1
+    (the energy is not linear in ε) have no range: epsilon_range() is None."""
+    assert lindstedt.expand("sin(u)", order=2, a0=1, omega0=1, normalization="harmonic").epsilon_range() is None
+    assert lindstedt.expand("u**3", order=2, a0=1, omega0=1, a1=1).epsilon_range() is None
