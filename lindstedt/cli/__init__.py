@@ -30,7 +30,12 @@ non-zero: 2 for bad input (arguments, files, values outside what a method takes)
 1 for a computation that failed (a numerical method that did not converge, an
 unexpected internal error).  JSON output never contains NaN or infinities: a
 failed numerical result has ``null`` values with ``"success": false`` and a message.
-A validity warning of an evaluated expansion (``--eps``) is one line ``warning: …`` on stderr.
+A validity warning of an evaluated expansion (``--eps``), like any other warning, is one line ``warning: …``
+on stderr.  Ctrl-C stops any command with the one line ``error: interrupted`` and exit status 130.
+Long commands (``forced`` sweeps, ``nnm --numeric``, ``expand`` from order 10) show their progress on
+stderr while they run when it is a terminal (a tqdm bar, if tqdm is installed), and otherwise print one
+summary line there when they succeed (e.g. ``forced: 214 points, 2 folds, 3.1 s``); stdout holds the
+result alone.
 Nothing is written to disk unless asked (``derive --output DIR``, ``demo --figure PATH``, ``forced --figure PATH``).
 """
 
@@ -41,11 +46,17 @@ import sys
 from typing import Any, Sequence
 
 from .._errors import ConvergenceError, LindstedtError, ProblemError
+from ._progress import Progress
+from ._signals import INTERRUPTS
 
 __all__ = ["main", "build_parser"]
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILED = 1
+#: Ctrl-C (SIGINT): the shell's convention, 128 + 2
+EXIT_INTERRUPTED = 130
+#: ``expand`` from this order on shows its progress (orders one by one)
+HIGH_ORDER = 10
 
 FORMATS = ("pretty", "plain", "text", "latex", "json")
 FORMAT_HELP = (
@@ -66,11 +77,10 @@ class _ArgumentParser(argparse.ArgumentParser):
 def _parse_parameters(items: Sequence[str]) -> dict[str, str | None]:
     parameters: dict[str, str | None] = {}
     for item in items:
-        if "=" in item:
-            name, value = item.split("=", 1)
-            parameters[name.strip()] = value.strip()
-        else:
-            parameters[item.strip()] = None
+        name, value = (part.strip() for part in item.split("=", 1)) if "=" in item else (item.strip(), None)
+        if name in parameters:
+            raise ProblemError(f"--param {name} is given twice ({parameters[name]} and {value}); give each parameter once")
+        parameters[name] = value
     return parameters
 
 
@@ -145,6 +155,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _command_expand(arguments: argparse.Namespace) -> str:
+    if arguments.order < HIGH_ORDER:
+        return _expand_output(arguments)
+    with Progress("expand", total=arguments.order + 2, unit="step") as progress:
+        text = _expand_output(arguments, progress)
+        progress.summary = f"orders 0-{arguments.order}"
+    return text
+
+
+def _expand_output(arguments: argparse.Namespace, progress: Progress | None = None) -> str:
     from ..methods.lindstedt_poincare import expand
 
     expansion = expand(
@@ -159,6 +178,11 @@ def _command_expand(arguments: argparse.Namespace) -> str:
         u0=arguments.u0,
         v0=arguments.v0,
     )
+    if progress is not None:  # the orders one by one (the hierarchy is lazy), then the output
+        for k in range(arguments.order + 1):
+            progress.update(status=f"order {k}")
+            expansion.omega_correction(k)
+        progress.update(status="formatting the output")
     evaluated = None if arguments.eps is None else _evaluate_expansion(expansion, arguments.eps)
     if arguments.format == "json":
         if evaluated is None:
@@ -390,7 +414,12 @@ def _numeric_nnm(system: Any, arguments: argparse.Namespace) -> tuple[str, int]:
         amplitude = {"modal_amplitude": parse_float(arguments.a0, what="--a0")}
     else:
         amplitude = {"energy": parse_float(arguments.energy, what="--energy")}
-    result = nnm_point(system, epsilon, arguments.mode, **amplitude)
+    with Progress("nnm", total=1, unit="orbit") as progress:
+        result = nnm_point(system, epsilon, arguments.mode, **amplitude)
+        progress.update()
+        if result.success:
+            progress.summary = (f"mode {arguments.mode} by shooting, {result.newton_iterations} Newton iterations, "
+                                f"{result.flow_evaluations} flows")
     status = 0 if result.success else EXIT_FAILED
     return (result.to_json() if arguments.format == "json" else result.summary()), status
 
@@ -407,9 +436,24 @@ def main(argv: Sequence[str] | None = None) -> int:
     omega(0.1) = 1.0375
     0
     """
+    import warnings
+
+    with INTERRUPTS:
+        try:
+            with warnings.catch_warnings():
+                warnings.showwarning = _show_warning
+                return _run(argv)
+        except KeyboardInterrupt:  # Ctrl-C anywhere, the imports of a command included: one line, no traceback
+            INTERRUPTS.ignore()
+            return _fail("interrupted", EXIT_INTERRUPTED)
+
+
+def _run(argv: Sequence[str] | None) -> int:
     status = 0
     try:
         arguments = build_parser().parse_args(argv)
+        with INTERRUPTS.deferred():  # mpmath (every command's) imports gmpy2 in a bare `except:` that swallows Ctrl-C
+            import mpmath  # noqa: F401
         if arguments.command == "expand":
             output = _command_expand(arguments)
         elif arguments.command == "nnm":
@@ -426,6 +470,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             output = run_demo(order=arguments.order, figure_path=arguments.figure or None)
         if isinstance(output, tuple):
             output, status = output
+        INTERRUPTS.check()  # a Ctrl-C that a library swallowed on the way
     except SystemExit as exit_request:  # --help and --version print and exit 0
         return int(exit_request.code or 0)
     except (_InputError, ProblemError) as error:
@@ -454,6 +499,11 @@ def _fail(error: Any, status: int) -> int:
     message = " ".join(str(error).split())  # one line
     print(f"error: {message}", file=sys.stderr)
     return status
+
+
+def _show_warning(message: Any, category: type, filename: str, lineno: int, file: Any = None, line: Any = None) -> None:
+    """A Python warning raised by a command: one line ``warning: <message>`` on stderr (no source line)."""
+    print(f"warning: {' '.join(str(message).split())} ({category.__name__})", file=sys.stderr if file is None else file)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -14,6 +14,7 @@ import json
 from typing import Any
 
 from .._errors import LindstedtError, ProblemError
+from ._progress import Progress
 
 __all__ = ["add_forced_parser", "run_forced"]
 
@@ -225,13 +226,28 @@ def run_forced(arguments: argparse.Namespace, parameters: dict[str, Any]) -> str
         from .demo import _figure_class
 
         _figure_class(arguments.figure)  # a bad suffix or no matplotlib fails before the computation
-    response = frequency_response(problem, start, stop, epsilon=epsilon)
-    if arguments.figure:
-        _draw(response, problem, arguments.figure)
-    text = response.to_json() if arguments.format == "json" else _response_text(response, arguments.format == "pretty")
-    if arguments.figure and arguments.format != "json":
-        text += f"\nfigure written to {arguments.figure}"
+    with Progress("forced", unit="point") as progress:
+        def report(index: int, orbit: Any) -> None:
+            progress.update(status=f"Ω = {orbit.frequency:.6g}, max|u| = {max(orbit.amplitude):.4g}")
+
+        response = frequency_response(problem, start, stop, epsilon=epsilon, callback=report)
+        if arguments.figure:
+            _draw(response, problem, arguments.figure)
+        text = response.to_json() if arguments.format == "json" else _response_text(response, arguments.format == "pretty")
+        if arguments.figure and arguments.format != "json":
+            text += f"\nfigure written to {arguments.figure}"
+        if response.success:
+            progress.summary = _summary(response)
     return text if response.success else (text, 1)
+
+
+def _summary(response: Any) -> str:
+    """``214 points, 2 folds`` (the bifurcations by kind, or none)."""
+    from collections import Counter
+
+    counts = Counter(event.kind for event in response.bifurcations)
+    kinds = ", ".join(f"{count} {kind}{'s' if count > 1 else ''}" for kind, count in counts.items()) or "no bifurcation"
+    return f"{len(response)} points, {kinds}"
 
 
 def _draw(response: Any, problem: Any, path: str) -> None:

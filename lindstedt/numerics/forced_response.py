@@ -433,8 +433,10 @@ def _next_step(h: float, iterations: int, first_correction: float, options: dict
 
 def _drive(cont: _Continuation, w0: np.ndarray, t0: np.ndarray, first: ForcedOrbit, value0: PeriodMapValue,
            J0: np.ndarray, *, stop: float | None, bounds: tuple[float, float], rejoin: bool, started: float,
-           first_message: str = "") -> FrequencyResponse:
+           first_message: str = "", callback: Callable[[int, ForcedOrbit], Any] | None = None) -> FrequencyResponse:
     options = cont.options
+    report = callback if callback is not None else (lambda index, orbit: None)
+    report(0, first)
     w, t, h = w0, t0, options["step"]
     points, arclength, bifurcations = [first], [0.0], []
     tests = cont.tests(value0, cont.tangent(J0, t0) if J0 is not None else t0)
@@ -486,7 +488,8 @@ def _drive(cont: _Continuation, w0: np.ndarray, t0: np.ndarray, first: ForcedOrb
                                      iterations=iterations, stability_tol=options["stability_tol"],
                                      samples=options["samples"], epsilon=getattr(cont.flow, "epsilon", None)))
                 arclength.append(arclength[-1] + h)
-            success = ok and (final or rejoin)
+                report(len(points) - 1, points[-1])
+            success = ok  # the branch was followed until it left the range, through stop or (past a fold) start
             if not ok:
                 message = f"the last point at {cont.parameter} = {target:.8g} failed: {why}"
             elif final:
@@ -494,10 +497,13 @@ def _drive(cont: _Continuation, w0: np.ndarray, t0: np.ndarray, first: ForcedOrb
             elif rejoin:
                 message = f"reached the end of the range, {cont.parameter} = {target:.8g}"
             else:
-                message = f"the branch turned back and left the range at {cont.parameter} = {target:.8g} (start)"
+                message = (f"the branch turned back at a fold and left the range through start, {cont.parameter} = "
+                           f"{target:.8g}; the responses nearer stop = {stop:.8g} lie on another part of the curve: "
+                           f"follow them from {stop:.8g} (or over a wider range)")
             break
         points.append(cont.orbit(w1, value, why, 0))
         arclength.append(arclength[-1] + h)
+        report(len(points) - 1, points[-1])
         h = _next_step(h, int(why.split()[0]), cont.first_correction, options)
         w, t, tests = w1, t1, new_tests
         peak = float(np.max(points[-1].amplitude))
@@ -536,7 +542,8 @@ def frequency_response(flow: PeriodMap | ForcedOscillator | ForcedSystem, start:
                        max_points: int = 1000, tol: float = 1e-10, max_iterations: int = 10,
                        stability_tol: float = 1e-7, locate_tol: float = 1e-9, samples: int = 512,
                        max_angle: float = 30.0, amplitude_scale: float | None = None,
-                       transient_periods: int = 100) -> FrequencyResponse:
+                       transient_periods: int = 100,
+                       callback: Callable[[int, ForcedOrbit], Any] | None = None) -> FrequencyResponse:
     """The branch of periodic responses from ``start`` to ``stop`` in Ω (or in s), through folds, with bifurcations.
 
     Parameters
@@ -568,12 +575,17 @@ def frequency_response(flow: PeriodMap | ForcedOscillator | ForcedSystem, start:
     stability_tol, samples, max_iterations, transient_periods, max_points
         See :func:`forced_periodic_orbit` (for the first point and every corrector); at most
         ``max_points`` points.
+    callback : callable, optional
+        ``callback(index, orbit)`` after every accepted point (the first is index 0), e.g. to show
+        progress; its return value is ignored.
 
     Returns
     -------
     FrequencyResponse
-        ``success=False`` and the reason when the first point fails, the steps collapse, the branch
-        reaches Ω ≤ 0 or turns back past ``start``, or ``max_points`` is reached.
+        ``success=True`` once the branch leaves the range: through ``stop``, or past a fold back through
+        ``start`` (in either direction of Ω; the message says which).  ``success=False`` and the reason
+        when the first point fails, the steps collapse, the branch reaches Ω ≤ 0, or ``max_points`` is
+        reached.
 
     Raises
     ------
@@ -630,7 +642,8 @@ def frequency_response(flow: PeriodMap | ForcedOscillator | ForcedSystem, start:
     if t0[-1] * (stop - start) < 0:
         t0 = -t0
     lo, hi = min(start, stop), max(start, stop)
-    return _drive(cont, w0, t0, first, value0, J0, stop=stop, bounds=(lo, hi), rejoin=False, started=started)
+    return _drive(cont, w0, t0, first, value0, J0, stop=stop, bounds=(lo, hi), rejoin=False, started=started,
+                  callback=callback)
 
 
 def switch_period_doubling(response: FrequencyResponse, index: int = 0, *, stop: float | None = None,
