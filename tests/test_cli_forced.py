@@ -108,3 +108,68 @@ def test_n_dof_forced_system_file_is_the_textbook_linear_response_below_its_gap(
 def test_n_dof_file_refuses_one_dof_options(arguments, message, capsys):
     assert main(["forced", EXAMPLE, "--eps", "0.5", "--at", "1", *arguments]) == 2
     assert message in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------- #
+# sweeps in either direction (issue 22): u'' + 0.04 u' + u + (u − 1/5)_+ = 0.04 cos Ωt, the README's example
+# --------------------------------------------------------------------------- #
+GAP = ["forced", "Max(0, u - 1/5)", "--eps", "1", "--zeta", "0.02", "--forcing", "0.04", "--format", "json"]
+
+
+def exact_period_residual(state, omega, zeta=0.02, forcing=0.04, gap=0.2):
+    """|X(2π/Ω) − X(0)| by DOP853 (rtol 1e-12) restarted at every crossing of the kink u = 1/5 (independent of the
+    package's flows); a periodic response gives ~1e-11."""
+    from scipy.integrate import solve_ivp
+
+    def field(t, y):
+        return [y[1], -2 * zeta * y[1] - y[0] - max(0.0, y[0] - gap) + forcing * np.cos(omega * t)]
+
+    def kink(t, y):
+        return y[0] - gap
+
+    t, y, end = 0.0, np.array(state, dtype=float), 2 * np.pi / omega
+    while t < end:
+        run = solve_ivp(field, (t, end), y, method="DOP853", rtol=1e-12, atol=1e-14, events=kink)
+        t, y = run.t[-1], run.y[:, -1]
+        if run.status == 1:  # stopped at the kink: step just across it
+            t_event = run.t_events[0][0]
+            t, y = t_event, run.y_events[0][0]
+            nudge = solve_ivp(field, (t, min(t + 1e-9, end)), y, method="DOP853", rtol=1e-12, atol=1e-14)
+            t, y = nudge.t[-1], nudge.y[:, -1]
+    return float(np.max(np.abs(y - np.asarray(state))))
+
+
+def _sweep(capsys, start, stop):
+    status = main([*GAP, "--from", start, "--to", stop])
+    captured = capsys.readouterr()
+    assert status == 0 and "error" not in captured.err, captured.err
+    return json.loads(captured.out)
+
+
+def test_a_downward_sweep_succeeds_and_is_the_upward_branch(capsys):
+    up, down = _sweep(capsys, "0.8", "1.2"), _sweep(capsys, "1.2", "0.8")
+    assert up["success"] is True and down["success"] is True and "reached stop = 0.8" in down["message"]
+    assert down["points"][0]["frequency"] == 1.2 and down["points"][-1]["frequency"] == pytest.approx(0.8, rel=1e-12)
+    folds_up = sorted(b["frequency"] for b in up["bifurcations"] if b["kind"] == "fold")
+    folds_down = sorted(b["frequency"] for b in down["bifurcations"] if b["kind"] == "fold")
+    assert len(folds_up) == 2 and np.allclose(folds_down, folds_up, rtol=0, atol=1e-6)
+    # every 5th point of the downward branch is a periodic response of the exact flow
+    for point in down["points"][::5]:
+        assert exact_period_residual(point["state"], point["frequency"]) < 1e-8 * max(1.0, max(point["amplitude"]))
+    # the same responses at the common ends (Newton at the exact Ω, residual 1e-10), in reverse order
+    for a, b in ((up["points"][0], down["points"][-1]), (up["points"][-1], down["points"][0])):
+        assert a["frequency"] == pytest.approx(b["frequency"], rel=1e-12)
+        assert np.allclose(a["state"], b["state"], rtol=1e-8, atol=1e-10) and a["stable"] == b["stable"]
+
+
+def test_a_downward_sweep_from_inside_the_hysteresis_turns_back_through_start_and_succeeds(capsys):
+    # Ω = 1.1 lies between the folds (1.0915, 1.1335): the branch through the response at 1.1 reaches the lower fold
+    # and turns back up the unstable branch to 1.1; it was reported as a failure (exit 1)
+    down, up = _sweep(capsys, "1.1", "0.8"), _sweep(capsys, "0.8", "1.6")
+    assert down["success"] is True and "through start" in down["message"] and "from 0.8" in down["message"]
+    assert [b["kind"] for b in down["bifurcations"]] == ["fold"]
+    lower_fold = min(b["frequency"] for b in up["bifurcations"] if b["kind"] == "fold")
+    assert down["bifurcations"][0]["frequency"] == pytest.approx(lower_fold, abs=1e-6)
+    assert down["points"][0]["stable"] and not down["points"][-1]["stable"]
+    for point in down["points"][::3]:
+        assert exact_period_residual(point["state"], point["frequency"]) < 1e-8

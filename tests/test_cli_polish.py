@@ -180,3 +180,91 @@ def test_demo_figure_suffix_and_missing_matplotlib_are_named(tmp_path, capsys, m
     assert main(["demo", "--order", "1", "--figure", str(tmp_path / "demo.png")]) == 2
     assert "pip install 'lindstedt[plot]'" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
+
+
+# --------------------------------------------------------------------------- #
+# malformed input through every sub-command: one `error:` line, exit 2 (bad input) or 1 (a computation that
+# failed), never a traceback nor an untyped "internal failure"
+# --------------------------------------------------------------------------- #
+FILES = {
+    "good": {"M": [[1, 0], [0, 1]], "K": [[2, -1], [-1, 2]], "A": [[1, 0]], "b": ["1/10"]},
+    "extra": {"M": [[1, 0], [0, 1]], "K": [[2, -1], [-1, 2]], "A": [[1, 0]], "b": [0], "X": 1},
+    "word": {"M": [[1, "a"], [0, 1]], "K": [[2, -1], [-1, 2]], "A": [[1, 0]], "b": [0]},
+    "shape": {"M": [[1, 0], [0, 1]], "K": [[2, -1], [-1, 2]], "A": [[1, 0, 3]], "b": [0]},
+    "list": [1, 2],
+    "string": "x",
+    "damping": {"system": {"M": [[1]], "K": [[1]], "A": [[1]], "b": [0]}, "load": [1], "rayleigh": [0, "x"]},
+    "noload": {"system": {"M": [[1]], "K": [[1]], "A": [[1]], "b": [0]}},
+    "load": {"system": {"M": [[1]], "K": [[1]], "A": [[1]], "b": [0]}, "load": [1, 2], "rayleigh": [0, 0.01]},
+    "twice": {"system": {"M": [[1]], "K": [[1]], "A": [[1]], "b": [0]}, "load": [1], "rayleigh": [0, 0.01], "C": [[1]]},
+}
+RAW = {"truncated": b'{"M": [[1, 0], [0, 1]], "K": [[2', "binary": b"\xff\xfe", "nan": b'{"M": [[NaN]], "K": [[1]], "A": [[1]], "b": [0]}'}
+MALFORMED = [
+    (2, "expand u**3 --order x"), (2, "expand u**3 --order 1.5"), (2, "expand u**3 --order -3"), (2, "expand u**3 --order 101"),
+    (2, "expand u**3 --order 99999999999999999999"), (2, "expand u**3 --a0 x_y"), (2, "expand u**3 --a0 nan"),
+    (2, "expand u**3 --a0 inf"), (2, "expand u**3 --a0 0 --omega0 1"), (2, "expand u**3 --omega0 0"), (2, "expand u**3 --omega0 1j"),
+    (2, "expand u**3 --omega0 I"), (2, "expand u**3 --param =1"), (2, "expand u**3 --param c=1"), (2, "expand c*u**3 --param c=x+"),
+    (2, "expand c*u**3 --param u=1"), (2, "expand c*u**3 --param c=1 --param c=2"), (2, "expand u**3 --precision 3"),
+    (2, "expand u**3 --precision x"), (2, "expand u**3 --normalization foo"), (2, "expand u**3 --a1 nan"),
+    (2, "expand u**3 --u0 1 --a0 1"), (2, "expand u**3 --u0 0 --v0 0"), (2, "expand u**3 --eps 1e999 --a0 1 --omega0 1"),
+    (2, "expand u**3 --eps 1/0 --a0 1 --omega0 1"), (2, "expand u** --order 1"), (2, "expand x**3"), (2, "expand 1/u"),
+    (2, "expand u**3 --order"), (2, "expand u**3 --bogus"), (2, "expand --order 2"), (2, "expand u**3 --format xml"),
+    (2, "expand Max(0,u-b) --param b --a0 1 --omega0 1 --eps 0.1"),
+    (2, "nnm /nonexistent/system.json --mode 1 --a0 1"), (2, "nnm {truncated} --mode 1 --a0 1"), (2, "nnm {list} --mode 1 --a0 1"),
+    (2, "nnm {extra} --mode 1 --a0 1"), (2, "nnm {word} --mode 1 --a0 1"), (2, "nnm {shape} --mode 1 --a0 1"),
+    (2, "nnm {binary} --mode 1 --a0 1"), (2, "nnm {nan} --mode 1 --a0 1"), (2, "nnm {directory} --mode 1 --a0 1"),
+    (2, "nnm {good} --mode 0 --a0 1"), (2, "nnm {good} --mode 3 --a0 1"), (2, "nnm {good} --mode x --a0 1"), (2, "nnm {good} --mode 1"),
+    (2, "nnm {good} --a0 1"), (2, "nnm {good} --mode 1 --a0 0"), (2, "nnm {good} --mode 1 --a0 1 --order 50"),
+    (2, "nnm {good} --mode 1 --a0 1 --precision 2"), (2, "nnm {good} --mode 1 --a0 1 --eps x"),
+    (2, "nnm {good} --mode 1 --numeric --a0 1"), (2, "nnm {good} --mode 1 --numeric --eps 1"),
+    (2, "nnm {good} --mode 1 --numeric --a0 1 --energy 1 --eps 1"), (2, "nnm {good} --mode 1 --numeric --energy 1 --eps nan"),
+    (1, "nnm {good} --mode 1 --numeric --a0 0 --eps 1"), (1, "nnm {good} --mode 1 --numeric --energy 0 --eps 1"),
+    (2, "forced u**3"), (2, "forced u**3 --eps x --at 1"), (2, "forced u**3 --eps -1 --at 1"), (2, "forced u**3 --eps 0.1 --at x"),
+    (2, "forced u**3 --eps 0.1 --at -1"), (2, "forced u**3 --eps 0.1 --at inf"), (2, "forced u**3 --eps 0.1 --from x --to 1"),
+    (2, "forced u**3 --eps 0.1 --from 0 --to 1"), (2, "forced u**3 --eps 0.1 --at 1 --omega0 0"), (2, "forced u**3 --eps 0.1 --at 1 --zeta x"),
+    (2, "forced u**3 --eps 0.1 --at 1 --forcing 0"), (2, "forced c*u**3 --eps 0.1 --at 1"), (2, "forced c*u**3 --eps 0.1 --at 1 --param c"),
+    (2, "forced u**3 --eps 0.1 --at 1 --param d=1"), (2, "forced c*u**3 --eps 0.1 --at 1 --param c=1 --param c=1"),
+    (2, "forced u**3 --eps 0.1 --at 1 --method foo"), (2, "forced u**3 --eps 0.1 --method multiple-scales --order 3"),
+    (2, "forced Max(0,u) --eps 0.1 --method multiple-scales --order 2"), (2, "forced u**3 --eps 0.1 --method multiple-scales --from 0.9"),
+    (2, "forced u**3 --eps 0.1 --from 0.9 --to 1.1 --figure noext"), (2, "forced /nonexistent.json --eps 0.1 --at 1"),
+    (2, "forced {truncated} --eps 0.1 --at 1"), (2, "forced {damping} --eps 0.1 --at 1"), (2, "forced {noload} --eps 0.1 --at 1"),
+    (2, "forced {load} --eps 0.1 --at 1"), (2, "forced {twice} --eps 0.1 --at 1"), (2, "forced {string} --eps 0.1 --at 1"),
+    (2, "forced {binary} --eps 0.1 --at 1"), (2, "forced {good} --eps 0.1 --at 1"), (2, "forced {directory} --eps 0.1 --at 1"),
+    (2, "forced u** --eps 0.1 --at 1"), (2, "forced u**3 --eps 0.1 --at 1 --bogus"),
+    (2, "derive"), (2, "derive nosuch"), (2, "derive ../../etc/passwd"), (2, "derive duffing --order x"), (2, "derive duffing --order -1"),
+    (2, "derive duffing --order 1000"), (2, "derive duffing --format pretty"),
+    (2, "demo --order x"), (2, "demo --order -1"), (2, "demo --order 1000"), (2, "demo --bogus"), (2, ""), (2, "bogus"), (2, "--bogus"),
+]
+
+
+@pytest.fixture
+def malformed_files(tmp_path):
+    paths = {"directory": str(tmp_path / "directory.json")}
+    (tmp_path / "directory.json").mkdir()
+    for name, data in FILES.items():
+        (tmp_path / f"{name}.json").write_text(json.dumps(data), encoding="utf-8")
+        paths[name] = str(tmp_path / f"{name}.json")
+    for name, data in RAW.items():
+        (tmp_path / f"{name}.json").write_bytes(data)
+        paths[name] = str(tmp_path / f"{name}.json")
+    return paths
+
+
+@pytest.mark.parametrize("status, command", MALFORMED)
+def test_malformed_input_is_one_typed_error_line(status, command, malformed_files, capsys):
+    assert main([word.format(**malformed_files) for word in command.split()]) == status
+    captured = capsys.readouterr()
+    lines = captured.err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), captured.err
+    assert "internal failure" not in lines[0] and "Traceback" not in captured.err
+    if status == 2:
+        assert captured.out == ""  # bad input computes nothing
+
+
+def test_a_library_warning_is_one_line_too():
+    # ε = 1e300 overflows inside the flow (numpy RuntimeWarnings): each is one `warning:` line, then the failure
+    result = subprocess.run([sys.executable, "-m", "lindstedt", "nnm", CHAIN, "--mode", "1", "--numeric", "--energy", "1",
+                             "--eps", "1e300"], capture_output=True, text=True, timeout=300, check=False)
+    lines = result.stderr.splitlines()
+    assert result.returncode == 1 and lines[-1].startswith("error: ") and "Traceback" not in result.stderr
+    assert lines[:-1] and all(line.startswith("warning: ") and line.endswith("(RuntimeWarning)") for line in lines[:-1])
