@@ -37,6 +37,7 @@ from ._errors import (
 # `import lindstedt` (and the CLI's --help) costs the interpreter, not sympy/numpy/mpmath.
 _LAZY = {
     "methods.all_modes": ("AllModesFirstOrder", "all_modes_first_order"),
+    "_precision": ("precision_lock",),
     "methods.lindstedt_poincare": ("LindstedtPoincare", "cache_info", "clear_cache", "expand"),
     "export.codegen": ("CodeGenerationError", "GeneratedCode", "generate_code"),
     "algebra.cosine": ("CosineSeries", "SineSeries", "solve_harmonic_oscillator"),
@@ -89,6 +90,7 @@ __all__ = [
     "expand",
     "clear_cache",
     "cache_info",
+    "precision_lock",
     "nnm",
     "all_modes_first_order",
     "AllModesFirstOrder",

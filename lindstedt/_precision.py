@@ -11,7 +11,18 @@ process.  Both are one problem — shared mutable state of a GIL-bound computati
 * :class:`workdps` / :class:`workprec` take it and then set mpmath's precision (the package's only way
   to change it), so a thread's precision holds for the whole block;
 * :func:`locked` takes it around a method that grows a shared structure or computes with mpmath numbers
-  at the ambient precision.
+  at the ambient precision;
+* :func:`locked_methods` takes it around every public method of a class (its constructor and displays too).
+
+sympy changes mpmath's precision as well, without asking: its numerical evaluation of a number such as
+``acos(1/3)`` — in ``float()``, ``is_positive``, a comparison, printing (which orders terms by their value),
+``collect`` — runs ``with mpmath.workprec(prec)`` (``Function._eval_evalf``), down to about 10 bits.  So every
+public entry point of the package that does sympy or mpmath work holds the lock: problem construction, the
+derivations, the results' symbolic views and exports, code generation, the references and validations
+(:func:`locked` on functions, :func:`locked_methods` on classes).  Only pure-float paths stay lock-free — the
+numerical integrators, and the float evaluators of a result once their data is compiled: :func:`locked_methods`
+names them, and each takes the lock itself on its slow path (``tests/test_threads.py`` records every change of
+mpmath's precision made without the lock over a representative set of public calls: there is none).
 
 A single lock cannot deadlock against itself (re-entrant, and nothing taken inside it waits for another
 thread's lock), and costs nothing measurable: derivation is bound to the GIL anyway, and the compiled
@@ -29,12 +40,33 @@ from typing import Any, Callable, TypeVar
 
 import mpmath
 
-__all__ = ["LOCK", "cached_property", "locked", "workdps", "workprec"]
+__all__ = ["LOCK", "cached_property", "locked", "locked_methods", "precision_lock", "workdps", "workprec"]
 
 #: The lock of mpmath's process-wide precision and of the package's lazily grown derivations.
 LOCK = threading.RLock()
 
 Function = TypeVar("Function", bound=Callable[..., Any])
+
+
+def precision_lock() -> Any:
+    """The package's lock of mpmath's process-wide precision: a re-entrant lock (``threading.RLock``).
+
+    Every public call of lindstedt that computes with sympy or mpmath holds it, so that no other call changes
+    mpmath's working precision meanwhile.  Your own code is not covered: sympy evaluating a number such as
+    ``acos(1/3)`` (in ``float()``, a comparison, printing) and ``mpmath.workdps`` set the one precision of the
+    process too.  If such code runs in one thread while another thread uses lindstedt, hold this lock around it.
+
+    Examples
+    --------
+    >>> import lindstedt, mpmath, sympy
+    >>> with lindstedt.precision_lock():
+    ...     with mpmath.workdps(30):
+    ...         value = mpmath.acos(mpmath.mpf(1) / 3)
+    ...     number = float(sympy.acos(sympy.Rational(1, 3)))
+    >>> mpmath.nstr(value, 20), round(number, 12)
+    ('1.2309594173407746821', 1.230959417341)
+    """
+    return LOCK
 
 
 class workprec:
@@ -103,12 +135,75 @@ def locked(function: Function) -> Function:
     True
     """
 
+    if getattr(function, "__locked__", False):
+        return function
+
     @functools.wraps(function)
     def run(*args: Any, **kwargs: Any) -> Any:
         with LOCK:
             return function(*args, **kwargs)
 
+    run.__locked__ = True  # type: ignore[attr-defined]
     return run  # type: ignore[return-value]
+
+
+#: Non-public names that are entry points too: the constructor, calls and the displays (repr, str, IPython's).
+_ENTRY_DUNDERS = frozenset({"__init__", "__call__", "__repr__", "__str__", "__format__", "_ipython_display_"})
+
+
+def _is_entry(name: str) -> bool:
+    return not name.startswith("_") or name in _ENTRY_DUNDERS or (name.startswith("_repr_") and name.endswith("_"))
+
+
+def _locked_member(owner: type, name: str, member: Any) -> Any:
+    """``member`` (a class attribute) with its code run under :data:`LOCK`; None for what is not code."""
+    if isinstance(member, staticmethod):
+        return staticmethod(locked(member.__func__))
+    if isinstance(member, classmethod):
+        return classmethod(locked(member.__func__))
+    if isinstance(member, functools.cached_property):  # computed once, then read from the instance lock-free
+        wrapped = type(member)(locked(member.func))
+        wrapped.__set_name__(owner, name)
+        return wrapped
+    if isinstance(member, property):
+        return property(*(None if part is None else locked(part) for part in (member.fget, member.fset, member.fdel)),
+                        member.__doc__)
+    if callable(member) and not isinstance(member, type):
+        return locked(member)
+    return None
+
+
+def locked_methods(*lock_free: str) -> Callable[[type], type]:
+    """Class decorator: every public method, property and cached property the class defines — and its constructor,
+    ``__call__`` and displays (``__repr__``, ``__str__``, IPython's ``_repr_*_``) — runs under :data:`LOCK`,
+    except the ``lock_free`` ones: float evaluators whose fast path must not pay for the lock and whose slow
+    path takes it itself.  Apply it above ``@dataclass`` (the generated constructor is then in the class).
+
+    Examples
+    --------
+    >>> @locked_methods("fast")
+    ... class Box:
+    ...     def held(self):
+    ...         return LOCK._is_owned()
+    ...     def fast(self):
+    ...         return LOCK._is_owned()
+    >>> Box().held(), Box().fast()
+    (True, False)
+    """
+
+    def decorate(cls: type) -> type:
+        unknown = set(lock_free) - set(vars(cls))
+        if unknown:
+            raise TypeError(f"{cls.__name__} defines no {sorted(unknown)}")
+        for name, member in list(vars(cls).items()):
+            if name in lock_free or not _is_entry(name):
+                continue
+            wrapped = _locked_member(cls, name, member)
+            if wrapped is not None:
+                setattr(cls, name, wrapped)
+        return cls
+
+    return decorate
 
 
 class cached_property(functools.cached_property):  # noqa: N801 — the name of what it replaces

@@ -27,7 +27,7 @@ import sympy
 from sympy import Rational
 
 from .._errors import LindstedtError
-from .._precision import workprec
+from .._precision import locked, locked_methods, workprec
 
 # Series at least this long multiply through one integer product (_doubled_product_sum) rather than the
 # pairwise loop: the crossover measured here is near 8 terms for gmpy rationals and 32 for mpf floats.
@@ -39,6 +39,7 @@ __all__ = ["CosineSeries", "SineSeries", "solve_harmonic_oscillator"]
 DomainElement = Any
 
 
+@locked_methods()
 class _TrigonometricSeries:
     """Shared machinery of cosine and sine series (dictionary of harmonics)."""
 
@@ -144,6 +145,7 @@ class _TrigonometricSeries:
         return np.tensordot(type(self)._numpy_basis(np.multiply.outer(points, harmonics)), values, axes=([-1], [0]))
 
 
+@locked_methods()
 class CosineSeries(_TrigonometricSeries):
     """Even cosine polynomial ``Σ_n c_n cos(n s)`` with coefficients in a sympy domain.
 
@@ -283,6 +285,7 @@ class CosineSeries(_TrigonometricSeries):
         return f"CosineSeries({terms or '0'})"
 
 
+@locked_methods()
 class SineSeries(_TrigonometricSeries):
     """Odd sine polynomial ``Σ_n c_n sin(n s)`` (derivatives of cosine series).
 
@@ -310,6 +313,7 @@ class SecularTermError(LindstedtError):
     """The right-hand side of the periodic solve still contains a cos(s) term."""
 
 
+@locked
 def solve_harmonic_oscillator(
     right_hand_side: CosineSeries,
     alpha0: DomainElement,

@@ -44,7 +44,7 @@ import sympy
 
 from .._errors import ProblemError
 from ..problems.parsing import parse_real
-from .._precision import workdps
+from .._precision import locked, workdps
 
 __all__ = [
     "KappaLike",
@@ -119,6 +119,7 @@ def _interior_status(kappa: sympy.Expr) -> str:
 # ---------------------------------------------------------------------------
 
 
+@locked
 def contact_angle(kappa: KappaLike) -> sympy.Expr:
     """Exact contact angle ``beta = arccos(kappa)`` clamped to ``[0, pi]``.
 
@@ -201,6 +202,7 @@ def _dispatch(
     )
 
 
+@locked
 def contact_ramp_coefficient(k: int, kappa: KappaLike, *, assume_interior: bool = False) -> sympy.Expr:
     """Exact cosine coefficient ``c_k[kappa]`` of ``(cos s - kappa)_+``.
 
@@ -235,6 +237,7 @@ def contact_ramp_coefficient(k: int, kappa: KappaLike, *, assume_interior: bool 
     return _dispatch(harmonic, _as_sympy_kappa(kappa), _ramp_interior, _ramp_below, assume_interior)
 
 
+@locked
 def contact_step_coefficient(k: int, kappa: KappaLike, *, assume_interior: bool = False) -> sympy.Expr:
     """Exact cosine coefficient ``h_k[kappa]`` of the Heaviside step ``H(cos s - kappa)``.
 
@@ -276,6 +279,7 @@ def _product_coefficient(
     return (coefficient(k + m) + low) / 2
 
 
+@locked
 def ramp_times_cosine_coefficient(
     k: int, kappa: KappaLike, m: int, *, assume_interior: bool = False
 ) -> sympy.Expr:
@@ -314,6 +318,7 @@ def ramp_times_cosine_coefficient(
     )
 
 
+@locked
 def step_times_cosine_coefficient(
     k: int, kappa: KappaLike, m: int, *, assume_interior: bool = False
 ) -> sympy.Expr:
@@ -430,6 +435,7 @@ def _coefficient_mp(k: int, kappa: KappaLike, precision: int, ramp: bool) -> mpm
         return +value
 
 
+@locked
 def contact_ramp_coefficient_mp(k: int, kappa: KappaLike, precision: int = 50) -> mpmath.mpf:
     """``c_k[kappa]`` with mpmath, correct to about ``precision`` significant digits.
 
@@ -462,6 +468,7 @@ def contact_ramp_coefficient_mp(k: int, kappa: KappaLike, precision: int = 50) -
     return _coefficient_mp(k, kappa, precision, ramp=True)
 
 
+@locked
 def contact_step_coefficient_mp(k: int, kappa: KappaLike, precision: int = 50) -> mpmath.mpf:
     """``h_k[kappa]`` with mpmath at ``precision`` digits (see :func:`contact_ramp_coefficient_mp`).
 

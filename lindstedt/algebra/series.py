@@ -20,7 +20,7 @@ import sympy
 
 from .._errors import ConvergenceError, ProblemError
 from .fourier import _as_harmonic
-from .._precision import workdps
+from .._precision import locked, workdps
 
 __all__ = ["SeriesEstimate", "series_sum", "sum_cosine_series_at"]
 
@@ -218,6 +218,7 @@ def _series_core(
         return SeriesEstimate(+value, +error, blocks.index - start_index, f"nsum {method}, {status}")
 
 
+@locked
 def series_sum(
     term_function: Callable[[int], object],
     start: int = 0,
@@ -279,6 +280,7 @@ def series_sum(
     return _series_core(term_function, start, precision, tolerance, max_terms, block_size, tuple(methods))
 
 
+@locked
 def sum_cosine_series_at(
     coefficients_function: Callable[[int], object],
     s: object,

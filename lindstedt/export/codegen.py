@@ -58,7 +58,7 @@ from sympy.printing.c import C99CodePrinter
 from sympy.printing.numpy import NumPyPrinter
 
 from .._errors import CodeGenerationError, ProblemError
-from .._precision import locked
+from .._precision import locked, locked_methods
 from ._names import _PYTHON_RESERVED, _safe_names
 from ._targets import _TARGETS, _renaming, _stable_target_source, _target_source, _wrapped
 from .stable import SERIES_TARGET, Patch, StableCoefficient, stable_coefficient
@@ -79,6 +79,7 @@ def _check_language(language: Any) -> None:
         )
 
 
+@locked_methods()
 @dataclass(frozen=True)
 class GeneratedCode:
     """Source code of one quantity in one language, with its calling convention.
@@ -195,6 +196,7 @@ def _generated(
     return GeneratedCode(language, quantity, name, tuple(a.name for a in arguments), source, accuracy)
 
 
+@locked
 def generate_code(expansion: Any, quantity: str = "frequency", language: str = "numpy") -> GeneratedCode:
     """Generate code for ``quantity`` of ``expansion`` in ``language``.
 

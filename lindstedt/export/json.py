@@ -57,6 +57,7 @@ import mpmath
 import numpy as np
 import sympy
 
+from .._precision import LOCK, locked, locked_methods
 from .display import format_number, format_vector, html_table, labelled_repr, shorten
 
 __all__ = ["JsonExport", "exported_fields", "finite_float", "to_jsonable"]
@@ -78,6 +79,7 @@ def _complex(real: Any, imag: Any) -> list[float | None]:
     return [finite_float(real), finite_float(imag)]
 
 
+@locked  # printing evaluates the numbers (sympy sets mpmath's precision)
 def _problem_dict(value: Any) -> dict[str, Any] | None:
     """The JSON form of the library's problems, or None for anything else."""
     from ..problems.oscillator import Oscillator
@@ -168,7 +170,8 @@ def to_jsonable(value: Any) -> Any:
     if problem is not None:
         return problem
     if isinstance(value, sympy.Basic):
-        return sympy.sstr(value)
+        with LOCK:
+            return sympy.sstr(value)
     if callable(getattr(value, "to_dict", None)) and not isinstance(value, type):
         return value.to_dict()
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
@@ -180,6 +183,7 @@ def to_jsonable(value: Any) -> Any:
     raise TypeError(f"to_jsonable cannot convert a {type(value).__name__}; give the result a to_dict() or a JSON rule here")
 
 
+@locked
 def display_value(value: Any) -> str:
     """A field of a result as short text for people: numbers to 10 digits, vectors cut to 8 entries,
     nested results and problems by name, long text shortened (see :mod:`lindstedt.export.display`).
@@ -215,6 +219,7 @@ def display_value(value: Any) -> str:
     return shorten(str(value), 160)
 
 
+@locked_methods()
 class JsonExport:
     """Mixin giving a result dataclass ``to_dict()`` and ``to_json()`` through :func:`to_jsonable`, and the
     displays for people: a labelled ``__repr__`` and Jupyter's ``_repr_html_`` table of the exported fields

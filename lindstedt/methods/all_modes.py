@@ -28,12 +28,14 @@ from typing import Sequence
 import numpy as np
 
 from .._errors import ProblemError
+from .._precision import locked, locked_methods
 from ..export.json import JsonExport
 from ..problems.system import UnilateralSystem
 
 __all__ = ["AllModesFirstOrder", "all_modes_first_order"]
 
 
+@locked_methods()
 @dataclass(frozen=True)
 class AllModesFirstOrder(JsonExport):
     """First-order frequency corrections λ_k¹ when all modes are excited.
@@ -114,6 +116,7 @@ def _hann_average(times: np.ndarray, values: np.ndarray) -> float:
     return float(np.trapezoid(values * window, times) / np.trapezoid(window, times))
 
 
+@locked
 def all_modes_first_order(
     system: UnilateralSystem,
     amplitudes: Sequence[float],

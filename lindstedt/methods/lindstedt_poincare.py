@@ -14,7 +14,7 @@ from collections import OrderedDict
 from typing import Any, Callable, Hashable, Mapping, NamedTuple
 
 from .._errors import OrderError, ProblemError
-from .._precision import LOCK
+from .._precision import LOCK, locked, locked_methods
 from ..results.expansion import Expansion
 from ..problems.oscillator import DISPLACEMENT, Oscillator
 from ..problems.piecewise_linear import has_non_polynomial_law
@@ -155,6 +155,7 @@ def _release_order_for(order: int) -> int:
     return order + 1
 
 
+@locked_methods()
 class LindstedtPoincare:
     """The method of strained coordinates (Lindstedt–Poincaré) for one oscillator.
 
@@ -268,6 +269,7 @@ def validate_order(order: Any) -> int:
     return order
 
 
+@locked
 def expand(
     f: Any,
     order: int = 2,

@@ -70,6 +70,7 @@ from typing import Any, Mapping
 import sympy
 
 from .._errors import OrderError, ParameterError, ProblemError, UnsupportedNonlinearityError
+from .._precision import locked, locked_methods
 from ..problems.forced import ForcedOscillator
 from ..problems.oscillator import DISPLACEMENT
 from ..problems.parsing import as_exact, parse_real
@@ -405,6 +406,7 @@ def _check_order(order: Any) -> int:
     return order
 
 
+@locked_methods()
 class MultipleScales:
     """The method of multiple scales (equivalently, averaging) for the primary resonance Ω ≈ ω0.
 
@@ -474,6 +476,7 @@ class MultipleScales:
         return FrequencyResponseCurve.build(problem, self.order, f1, assumptions, second)
 
 
+@locked
 def frequency_response_curve(
     problem: Any,
     order: int = 1,

@@ -19,7 +19,7 @@ import numpy as np
 import sympy
 
 from .._errors import ProblemError
-from .._precision import locked
+from .._precision import locked, locked_methods
 from ..engine.branches import BranchHierarchy
 from ..engine.modal import modal_guard_digits, modal_normal_form
 from ..problems.nnm import NNMProblem
@@ -29,6 +29,7 @@ from ..results.nnm import NNMExpansion
 __all__ = ["StrainedCoordinatesNNM", "nnm", "release_amplitudes_by_series"]
 
 
+@locked_methods()
 class StrainedCoordinatesNNM:
     """The method: Lindstedt–Poincaré NNM expansion of an N-dof unilateral system (one verb, :meth:`expand`).
 
@@ -128,6 +129,7 @@ def release_amplitudes_by_series(system: UnilateralSystem, mode: int, a0: Any, *
     return results
 
 
+@locked
 def nnm(system: UnilateralSystem, mode: int, a0: Any, order: int = 2, *, a1: Any = 0, precision: int = 30) -> NNMExpansion:
     """Nonlinear normal mode of ``M X'' + K X + ε W (A X − b)_+ = 0`` grown from ``mode`` (strained coordinates).
 

@@ -74,6 +74,7 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 import numpy as np
 
 from .._errors import ProblemError
+from .._precision import locked
 from ..export.display import format_number, format_vector, html_table, labelled_repr
 from ..export.json import JsonExport, exported_fields, to_jsonable
 from ..problems.system import UnilateralSystem
@@ -277,6 +278,7 @@ class FlowResult(JsonExport):
         return html_table(f"FlowResult: {'success' if self.success else 'FAILED'}", self._display_rows(quoted=False))
 
 
+@locked  # sympy printing
 def _problem_json(problem: Any) -> Any:
     """The JSON form of the problem a flow ran on (forced problems included)."""
     from ..problems.forced import ForcedOscillator, ForcedSystem  # here: import lindstedt stays light

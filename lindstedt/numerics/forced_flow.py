@@ -50,6 +50,7 @@ import numpy as np
 import sympy
 
 from .._errors import ConvergenceError, ParameterError, ProblemError, ResonanceError, UnsupportedNonlinearityError
+from .._precision import locked
 from ..problems.forced import ForcedOscillator, ForcedSystem, check_forcing_frequency
 from ..problems.piecewise_linear import decompose_piecewise_linear
 from ._period_map import PeriodMapValue
@@ -148,6 +149,7 @@ class ForcedFlow:
     ((2,), (2, 2), (2,))
     """
 
+    @locked  # the problem's sympy numbers to floats
     def __init__(self, problem: ForcedSystem | ForcedOscillator, epsilon: float, *, max_arcs: int = 1_000_000) -> None:
         eps = _real(epsilon, "epsilon")
         if eps < 0.0:

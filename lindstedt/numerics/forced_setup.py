@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from .._errors import LindstedtError, ParameterError, ProblemError
+from .._precision import locked
 from ..problems.forced import ForcedOscillator, ForcedSystem
 from ._period_map import PeriodMap
 
@@ -36,6 +37,7 @@ def _description(flow: Any) -> Any:
     return {"kind": type(flow).__name__, "description": repr(flow)}
 
 
+@locked
 def forced_flow(problem: ForcedOscillator | ForcedSystem, epsilon: float) -> PeriodMap:
     """The flow that computes ``problem``'s responses: exact where it can be, DOP853 elsewhere.
 

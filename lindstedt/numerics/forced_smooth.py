@@ -40,6 +40,7 @@ import sympy
 
 from .._errors import ConvergenceError, ProblemError, UnsupportedNonlinearityError
 from .forced_setup import _real as _real_number
+from .._precision import locked
 from ..problems.forced import ForcedOscillator, ForcedSystem, check_forcing_frequency
 from ._period_map import PeriodMapValue
 
@@ -191,6 +192,7 @@ class SmoothForcedFlow:
     (0.2,)
     """
 
+    @locked  # the problem's sympy numbers to floats, f lambdified
     def __init__(self, problem: ForcedOscillator | ForcedSystem, epsilon: float, *, rtol: float = 1e-12,
                  atol: float = 1e-14) -> None:
         eps = _real_number(epsilon, "epsilon")

@@ -82,7 +82,6 @@ Examples
 from __future__ import annotations
 
 import math
-import threading
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -91,6 +90,7 @@ from typing import Any
 import numpy as np
 
 from .._errors import ConvergenceError, ProblemError
+from .._precision import LOCK
 from .flow import ExactFlow
 from ..problems.parsing import parse_float
 from ..problems.system import UnilateralSystem
@@ -753,9 +753,6 @@ def _newton(
                           max_iterations, current, tuple(sizes))
 
 
-_EXPANSION_LOCK = threading.Lock()
-
-
 class _ExpansionPredictor:
     """Newton guesses from the strained-coordinates NNM expansion (:func:`lindstedt.nnm`, order 2).
 
@@ -785,8 +782,8 @@ class _ExpansionPredictor:
             from .. import nnm  # here: the expansion engine is only needed when a guess is asked for
 
             try:
-                # one expansion at a time: mpmath's working precision is process-global (nnm_sweep may use threads)
-                with _EXPANSION_LOCK, warnings.catch_warnings():
+                # the package's one lock (nnm takes it too: one lock, no lock order to get wrong)
+                with LOCK, warnings.catch_warnings():
                     warnings.simplefilter("ignore")
                     cache[key] = nnm(problem.system, problem.mode, a0=a0, order=2)
             except Exception:  # noqa: BLE001 — a predictor only: any failure of the expansion means "no predictor"

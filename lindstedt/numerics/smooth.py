@@ -14,6 +14,7 @@ import numpy as np
 import sympy
 
 from .._errors import ProblemError
+from .._precision import locked
 from .flow import FlowResult, SwitchEvent, _as_time
 
 __all__ = ["smooth_flow"]
@@ -22,6 +23,7 @@ __all__ = ["smooth_flow"]
 # --------------------------------------------------------------------------- #
 # smooth fallback
 # --------------------------------------------------------------------------- #
+@locked  # parsing and lambdify: sympy
 def _as_scalar_function(f: Any) -> Callable[[float], float]:
     if isinstance(f, str):
         from ..problems.parsing import parse_expression

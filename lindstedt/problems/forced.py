@@ -24,6 +24,7 @@ import numpy as np
 import sympy
 
 from .._errors import ParameterError, ProblemError
+from .._precision import locked, locked_methods
 from .oscillator import Oscillator
 from .parsing import parse_real
 from .system import UnilateralSystem, _exact_matrix, _exact_scalar, _float_array
@@ -33,6 +34,7 @@ __all__ = ["ForcedOscillator", "ForcedSystem", "check_forcing_frequency"]
 DAMPING_KINDS = ("rayleigh", "modal", "matrix")
 
 
+@locked
 def check_forcing_frequency(value: Any, name: str = "Omega") -> float:
     """The forcing frequency Ω as a positive finite float, or a :class:`ParameterError` naming the fix.
 
@@ -64,6 +66,7 @@ def _nonnegative(value: Any, what: str) -> sympy.Expr:
     return exact
 
 
+@locked_methods()
 @dataclass(frozen=True)
 class ForcedOscillator:
     """The forced, damped oscillator ``u'' + 2 ζ ω0 u' + ω0² u + ε f(u) = ε F cos(Ω t)``.
@@ -198,6 +201,7 @@ def _symmetric_positive_semidefinite(C: np.ndarray, C_exact: sympy.ImmutableMatr
         )
 
 
+@locked_methods()
 class ForcedSystem:
     """``M X'' + C X' + K X + ε W (A X − b)_+ = ε P cos(Ω t)``: a unilateral system, damped and forced.
 

@@ -6,12 +6,14 @@ from dataclasses import dataclass
 from typing import Any
 
 from .._errors import ProblemError
+from .._precision import locked_methods
 from .parsing import parse_real
 from .system import UnilateralSystem
 
 __all__ = ["NNMProblem"]
 
 
+@locked_methods()
 @dataclass(frozen=True)
 class NNMProblem:
     """The NNM grown from linear mode j of ``M X'' + K X + ε W (A X − b)_+ = 0``, released at rest.

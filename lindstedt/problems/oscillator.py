@@ -46,7 +46,7 @@ from typing import Any, Mapping
 
 import sympy
 
-from .._precision import LOCK
+from .._precision import LOCK, locked_methods
 from .._errors import ParameterError, ProblemError, UnsupportedNonlinearityError
 from .parsing import ALLOWED_FUNCTIONS, CONSTANTS, as_exact, parse_expression, parse_real, parse_value
 from .piecewise_linear import decompose_piecewise
@@ -275,6 +275,7 @@ class _TurningPoint:
         return value
 
 
+@locked_methods()
 @dataclass(frozen=True)
 class Oscillator:
     """Weakly nonlinear oscillator ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0 + ε a1``, ``u'(0) = 0``.

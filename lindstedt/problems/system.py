@@ -31,7 +31,7 @@ import sympy
 
 from .._errors import ProblemError
 from .parsing import parse_real
-from .._precision import cached_property, locked, workdps, workprec
+from .._precision import cached_property, locked, locked_methods, workdps, workprec
 
 __all__ = ["UnilateralSystem", "Modes", "OneDofUnilateral"]
 
@@ -182,6 +182,7 @@ def _json_entry(expr: sympy.Expr) -> str:
 # --------------------------------------------------------------------------- #
 # the problem
 # --------------------------------------------------------------------------- #
+@locked_methods("n_dof", "n_springs", "modes", "gaps", "acceleration", "energy")  # floats: the integrators' own
 @dataclass(frozen=True, init=False, eq=False, repr=False)
 class UnilateralSystem:
     """The problem ``M X'' + K X + ε W (A X − b)_+ = 0`` (ε is given to the solvers).
@@ -850,6 +851,7 @@ def _dense_mpmath_modes(system: "UnilateralSystem", digits: int) -> tuple[list[A
         return [+value for value in frequencies], [[+value for value in column] for column in shapes]
 
 
+@locked
 def OneDofUnilateral(omega0: Any, a: Any = 1, b: Any = 0) -> UnilateralSystem:
     """Factory for ``u'' + ω0² u + ε (a u − b)_+ = 0`` (same as :meth:`UnilateralSystem.one_dof`).
 

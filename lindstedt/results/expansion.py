@@ -60,7 +60,7 @@ import math
 import re
 import warnings
 from dataclasses import dataclass, field
-from .._precision import cached_property, locked, workdps
+from .._precision import cached_property, locked, locked_methods, workdps
 from collections import OrderedDict
 from typing import Any, Callable, Mapping, NamedTuple, Sequence
 
@@ -232,6 +232,7 @@ def _finite(numbers: np.ndarray, substitution: Mapping[sympy.Symbol, sympy.Expr]
     return numbers
 
 
+@locked_methods()
 @dataclass(frozen=True)
 class Waveform:
     """An exact even cosine polynomial ``v_k(s) = Σ_n c_n cos(n s)``.
@@ -271,6 +272,7 @@ class Waveform:
         return _latex(self.to_expr())
 
 
+@locked_methods()
 @dataclass(frozen=True)
 class PiecewiseWaveform:
     """A correction v_k of a piecewise-linear problem, exact and piecewise in closed form.
@@ -517,6 +519,7 @@ def _horner(points: Any, coefficients: np.ndarray) -> Any:
     return result
 
 
+@locked_methods("frequency")  # its scalar fast path is lock-free; the general path, _frequency, is locked
 @dataclass(frozen=True)
 class Expansion:
     """Lindstedt–Poincaré expansion of an :class:`~lindstedt.Oscillator` to a given order.
@@ -832,6 +835,7 @@ class Expansion:
                 return total
         return self._frequency(epsilon, values, order)
 
+    @locked
     def _frequency(self, epsilon: Any, values: Mapping[Any, Any] | None, order: int | None) -> Any:
         last = self._steps * (self.order if order is None else order)
         point = self._read(values)
@@ -935,8 +939,8 @@ class Expansion:
         expansion was derived for, and ``radius``, the distance to the nearest singularity of ω(ε) the law gives
         (see :mod:`lindstedt.results.orbit_range`).
 
-        None where it is not computed: non-polynomial pieces (fractional or analytic contact laws, smooth f
-        such as sin u), a release shifted by ε a1, and the "harmonic" normalization.
+        Computed for every law (pieces that are not polynomials — sin u, Hertz — numerically, their radius from
+        the real events only); None for a release shifted by ε a1 and the "harmonic" normalization.
 
         The evaluators (:meth:`frequency`, :meth:`displacement`, :meth:`velocity`, the error estimates) raise
         a :class:`~lindstedt.ParameterError` at an ε where no periodic orbit exists (the motion escapes over a

@@ -31,6 +31,7 @@ import numpy as np
 import sympy
 
 from .._errors import ParameterError, ProblemError
+from .._precision import locked_methods
 from ..export.display import jupyter_latex, labelled_repr, latex_text, shorten
 from ..export.json import JsonExport
 from ..problems.forced import ForcedOscillator, check_forcing_frequency
@@ -102,6 +103,7 @@ def _branch_sign(branch: Any) -> int:
     raise ParameterError(f"branch must be 'upper' (σ+) or 'lower' (σ−), got {branch!r}")
 
 
+@locked_methods()
 @dataclass(frozen=True)
 class FrequencyResponseCurve(JsonExport):
     r"""The frequency response of a forced oscillator near Ω = ω0 by multiple scales (frozen; symbolic).

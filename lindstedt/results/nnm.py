@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import warnings
 from dataclasses import dataclass, field
-from .._precision import cached_property
+from .._precision import cached_property, locked_methods
 from typing import Any
 
 import mpmath
@@ -36,6 +36,7 @@ from ..problems.system import UnilateralSystem
 __all__ = ["NNMExpansion"]
 
 
+@locked_methods()
 @dataclass(frozen=True)
 class NNMExpansion:
     """Strained-coordinates NNM of mode j to order 2 (and beyond), in physical units.

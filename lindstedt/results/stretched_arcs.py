@@ -19,7 +19,7 @@ from .._errors import OrderError
 from ..engine.stretched import FloatArc
 from ..export.display import DIGITS, format_number, format_vector, jupyter_latex, labelled_repr
 from ..export.json import JsonExport
-from .._precision import workdps
+from .._precision import locked_methods, workdps
 
 __all__ = ["STRETCHED_TIME", "StretchedArcSeries"]
 
@@ -35,6 +35,7 @@ def _chebyshev_sum(coefficients: list[Any], x: Any) -> Any:
     return coefficients[0] + x * later - latest
 
 
+@locked_methods()
 @dataclass(frozen=True)
 class StretchedArcSeries(JsonExport):
     """A contact arc with a non-polynomial law (Hertz, analytic), expanded in its own stretched time.

@@ -37,6 +37,7 @@ import numpy as np
 import sympy
 
 from .._errors import ProblemError, UnsupportedNonlinearityError
+from .._precision import LOCK, locked
 from ..export.json import JsonExport
 from ..results.expansion import Expansion
 from ..numerics.flow import ExactFlow, FlowResult
@@ -129,6 +130,7 @@ def _problem_of(source: Oscillator | Expansion) -> Oscillator:
     raise ProblemError(f"expected an Oscillator or an Expansion, got {type(source).__name__}")
 
 
+@locked  # the problem's sympy numbers to floats (the integration after it is lock-free)
 def _numeric_problem(source: Oscillator | Expansion, values: Mapping[Any, Any] | None) -> _NumericProblem:
     problem = _problem_of(source)
     substitution = problem.numeric_substitution(values)
@@ -155,12 +157,14 @@ def _numeric_problem(source: Oscillator | Expansion, values: Mapping[Any, Any] |
     return _NumericProblem(omega0, a0, nonlinearity, law, problem.is_non_smooth)
 
 
+@locked
 def _initial_velocity(source: Oscillator | Expansion) -> float:
     """u'(0): v0 of a problem built from general initial data, else 0 (a release at rest)."""
     problem = _problem_of(source)
     return float(problem.v0) if problem.has_initial_velocity else 0.0
 
 
+@locked
 def _initial_displacement(source: Oscillator | Expansion, numeric: _NumericProblem, epsilon: float,
                           a1: float, values: Mapping[Any, Any] | None) -> float:
     problem = _problem_of(source)
@@ -419,7 +423,8 @@ def reference_solution(
         else:
             outcome = _flow_outcome(flow, "exact", flow.message, flow.n_switches, shift)
     else:
-        function = sympy.lambdify(DISPLACEMENT, numeric.nonlinearity, modules="math")
+        with LOCK:  # printing the expression evaluates its numbers (sympy)
+            function = sympy.lambdify(DISPLACEMENT, numeric.nonlinearity, modules="math")
         flow = smooth_flow(lambda u: float(function(u)), numeric.omega0, eps, u0, v0, t_end, rtol, atol)
         message = flow.message
         if numeric.is_non_smooth:
