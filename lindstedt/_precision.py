@@ -35,12 +35,15 @@ the same property of another instance); a value computed twice by two threads is
 from __future__ import annotations
 
 import functools
+import os
+import sys
 import threading
+import warnings
 from typing import Any, Callable, TypeVar
 
 import mpmath
 
-__all__ = ["LOCK", "cached_property", "locked", "locked_methods", "precision_lock", "workdps", "workprec"]
+__all__ = ["LOCK", "cached_property", "locked", "locked_methods", "precision_lock", "warn_caller", "workdps", "workprec"]
 
 #: The lock of mpmath's process-wide precision and of the package's lazily grown derivations.
 LOCK = threading.RLock()
@@ -204,6 +207,28 @@ def locked_methods(*lock_free: str) -> Callable[[type], type]:
         return cls
 
     return decorate
+
+
+_PACKAGE = os.path.dirname(os.path.abspath(__file__)) + os.sep
+
+
+def warn_caller(warning: Warning) -> None:
+    """``warnings.warn(warning)`` attributed to the first frame outside the package — the user's call — however
+    many of the package's frames (the lock's wrappers among them) lie between.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     warn_caller(UserWarning("checked"))
+    >>> str(caught[0].message), caught[0].filename.endswith("_precision.py")
+    ('checked', False)
+    """
+    frame, level = sys._getframe(0), 1
+    while frame.f_back is not None and frame.f_code.co_filename.startswith(_PACKAGE):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(warning, stacklevel=level)
 
 
 class cached_property(functools.cached_property):  # noqa: N801 — the name of what it replaces

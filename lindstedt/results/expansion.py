@@ -58,9 +58,8 @@ from __future__ import annotations
 import json
 import math
 import re
-import warnings
 from dataclasses import dataclass, field
-from .._precision import cached_property, locked, locked_methods, workdps
+from .._precision import cached_property, locked, locked_methods, warn_caller, workdps
 from collections import OrderedDict
 from typing import Any, Callable, Mapping, NamedTuple, Sequence
 
@@ -846,7 +845,7 @@ class Expansion:
         result = _horner(points, coefficients)
         message = self._range_message(epsilon, point, values) or self._series_message(coefficients, last, points, point)
         if message:
-            warnings.warn(ExpansionValidityWarning(message), stacklevel=4)
+            warn_caller(ExpansionValidityWarning(message))
         if values is None and order is None and not point.arrays and self._steps == 1 and not message:
             self._set_fast_frequency(coefficients, last)
         return float(result) if np.ndim(result) == 0 else result
@@ -858,7 +857,7 @@ class Expansion:
         result = np.polynomial.polynomial.polyval(points, coefficients[: last + 1])
         message = self._range_message(epsilon, None, values) or series_warning(coefficients, last, points, str(self.gauge))
         if message:
-            warnings.warn(ExpansionValidityWarning(message), stacklevel=4)
+            warn_caller(ExpansionValidityWarning(message))
         return float(result) if np.ndim(result) == 0 else result
 
     def frequency_coefficients(self, values: Mapping[Any, Any] | None = None, *, order: int | None = None) -> np.ndarray:
@@ -904,7 +903,7 @@ class Expansion:
         estimate = np.abs(coefficient * self._gauge_values(epsilon) ** (last + 1))
         message = self._range_message(epsilon, point, values)
         if message:
-            warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
+            warn_caller(ExpansionValidityWarning(message))
         return estimate
 
     def displacement_error_estimate(self, t: Any, epsilon: float, values: Mapping[Any, Any] | None = None) -> np.ndarray:
@@ -924,7 +923,7 @@ class Expansion:
         eta = float(self._gauge_values(float(epsilon)))
         message = self._range_message(epsilon, None, values)
         if message:
-            warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
+            warn_caller(ExpansionValidityWarning(message))
         # The displacement pairs v_0 … v_n with ω through ω_{n+1}: its phase drifts with the next terms, one power of ε
         # of them (two in the gauge ε^{1/2}, whose analytic and non-analytic terms interleave).
         coefficients = self._frequency_coefficients(last + 1 + self._steps, values)
@@ -1087,7 +1086,7 @@ class Expansion:
         if message is None:
             message = self._drift_message(coefficients, last, eta, times, point)
         if message:
-            warnings.warn(ExpansionValidityWarning(message), stacklevel=3)
+            warn_caller(ExpansionValidityWarning(message))
         strained = times * frequency
         if self.problem.has_initial_velocity:
             strained = strained + _horner(eta, self._phase_values(point))
@@ -1113,7 +1112,7 @@ class Expansion:
         if message is None:
             message = phase_warning(drift, times)
         if message:
-            warnings.warn(ExpansionValidityWarning(message), stacklevel=4)
+            warn_caller(ExpansionValidityWarning(message))
         strained = times * frequency + self._phase_value(gauge, values)
         result = amplitude * branches.evaluate(strained, scale ** (1 / self._steps) * gauge, derivative)[..., 0]
         if derivative:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import warnings
 from dataclasses import dataclass, field
-from .._precision import cached_property, locked_methods
+from .._precision import cached_property, locked_methods, warn_caller
 from typing import Any
 
 import mpmath
@@ -139,7 +139,7 @@ class NNMExpansion:
         eta = self._gauge_values(epsilon)
         message = self._series_message(eta)
         if message:
-            warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
+            warn_caller(ExpansionValidityWarning(message))
         return np.polynomial.polynomial.polyval(eta, self._known_coefficients)
 
     def _series_message(self, eta: np.ndarray) -> str | None:
@@ -237,7 +237,7 @@ class NNMExpansion:
             float(self._tail(float(np.max(np.abs(eta), initial=0.0)))[0]), times
         )
         if message:
-            warnings.warn(ExpansionValidityWarning(message), stacklevel=2)
+            warn_caller(ExpansionValidityWarning(message))
         strained = times * np.polynomial.polynomial.polyval(eta, self._known_coefficients)
         scaled = eta * (lam * lam) ** (-1 / self.gauge)
         if not scaled.ndim:
