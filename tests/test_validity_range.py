@@ -292,6 +292,9 @@ _SEPARATRICES = [
     ("Max(0, u)**(3/2)", _HERTZ, lambda u: max(u, 0.0) ** 1.5, 1, "lower", -1.0, "escape"),
     ("Max(0, u - 1/2)**(3/2)", _HERTZ_GAP, lambda u: max(u - 0.5, 0.0) ** 1.5, 1, "lower", -(2**1.5), "escape"),
     ("-u + u**3", -U + U**3, lambda u: -u + u**3, sympy.Rational(6, 5), "upper", 25 / 7, "well"),
+    # the release point is a double root of the event equation D(u) (no sign change): found from ω0² a0 + ε f(a0) = 0
+    ("Max(0, u - 1/2)**(3/2) - u/2", _HERTZ_GAP - U / 2, lambda u: max(u - 0.5, 0.0) ** 1.5 - u / 2, 3, "lower",
+     -3 / (2.5**1.5 - 1.5), "escape"),
     ("-u + u**3", -U + U**3, lambda u: -u + u**3, 1, "upper", 2.0, "well"),
 ]
 
@@ -405,3 +408,16 @@ def test_normalizations_without_a_fixed_release_are_left_to_the_series_check():
     (the energy is not linear in ε) have no range: epsilon_range() is None."""
     assert lindstedt.expand("sin(u)", order=2, a0=1, omega0=1, normalization="harmonic").epsilon_range() is None
     assert lindstedt.expand("u**3", order=2, a0=1, omega0=1, a1=1).epsilon_range() is None
+
+
+def test_an_orbit_leaving_the_resolved_interval_is_warned_not_refused():
+    """cos(u) − 1, a0 = 1: V = u²/2 + ε (sin u − u) is bounded below for every ε, so the orbit is periodic at ε = −7
+    (the flow closes), but its turning point, near u = −14, lies past the interval where the geometric grid resolves
+    the oscillation (~12 amplitudes): the range ends there with a warning, never a refusal."""
+    expansion = lindstedt.expand("cos(u) - 1", order=3, a0=1, omega0=1)
+    bounds = expansion.epsilon_range()
+    assert "not followed" in bounds.lower_reason and -8 < bounds.lower < -4
+    _, messages = _caught(lambda: expansion.frequency(-7.0))
+    assert len(messages) == 1 and "not followed" in messages[0]
+    flow = _flow(lambda u: math.cos(u) - 1, -7.0, 1.0, horizon=40.0)
+    assert not flow["escaped"] and flow["low"] < -12 and flow["closure"] < 1e-6
