@@ -133,8 +133,8 @@ def range_function(problem: Oscillator, symbols: tuple[sympy.Symbol, ...]) -> Ca
         for coefficient, point, exponent in fractional:
             numbers += [coefficient, point, exponent]
         shape.append((len(coefficients), len(fractional)))
-        analytic_terms.append(None if analytic == 0 else sympy.lambdify((DISPLACEMENT, *symbols), analytic, modules="numpy"))
-    compiled = sympy.lambdify(symbols, numbers, modules="math")
+        analytic_terms.append(None if analytic == 0 else sympy.lambdify((DISPLACEMENT, *symbols), analytic, modules="numpy", dummify=True))
+    compiled = sympy.lambdify(symbols, numbers, modules="math", dummify=True)
 
     def evaluate(*values: float) -> tuple[Any, ...]:
         flat = [float(value) for value in compiled(*values)]
