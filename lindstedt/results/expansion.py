@@ -59,7 +59,7 @@ import json
 import math
 import re
 from dataclasses import dataclass, field
-from .._precision import cached_property, locked, locked_methods, warn_caller, workdps
+from .._precision import LOCK, cached_property, locked, locked_methods, warn_caller, workdps
 from collections import OrderedDict
 from typing import Any, Callable, Mapping, NamedTuple, Sequence
 
@@ -518,7 +518,7 @@ def _horner(points: Any, coefficients: np.ndarray) -> Any:
     return result
 
 
-@locked_methods("frequency")  # its scalar fast path is lock-free; the general path, _frequency, is locked
+@locked_methods("frequency", "displacement", "velocity")  # float evaluators: each locks its own slow part
 @dataclass(frozen=True)
 class Expansion:
     """Lindstedt–Poincaré expansion of an :class:`~lindstedt.Oscillator` to a given order.
@@ -1073,25 +1073,26 @@ class Expansion:
         return cached[1]
 
     def _evaluate(self, t: Any, epsilon: Any, values: Mapping[Any, Any] | None, derivative: bool) -> Any:
-        point = self._read(values)
-        if point is None or self._stretched_pieces:
-            return self._evaluate_exact(t, epsilon, values, derivative)
-        last = self._steps * self.order
-        coefficients = self._omega_values(last + 1, point)  # the frequency through ω_{N+1}
-        eta = self._gauge_values(epsilon)
-        times = np.asarray(t, dtype=float)
-        frequency = _horner(eta, coefficients)
-        message = self._range_message(epsilon, point, values) or self._series_message(
-            coefficients[: last + 1], last, eta, point, coefficients[last + 1])
-        if message is None:
-            message = self._drift_message(coefficients, last, eta, times, point)
-        if message:
-            warn_caller(ExpansionValidityWarning(message))
-        strained = times * frequency
-        if self.problem.has_initial_velocity:
-            strained = strained + _horner(eta, self._phase_values(point))
-        layout = self._waveform_layout
-        data = self._waveform_data(point, float(np.max(np.abs(eta))) if eta.size else 0.0)  # accurate for the largest |η|
+        with LOCK:  # the values read, the float data (compiled on first use) and the warnings: sympy on a slow path
+            point = self._read(values)
+            if point is None or self._stretched_pieces:
+                return self._evaluate_exact(t, epsilon, values, derivative)
+            last = self._steps * self.order
+            coefficients = self._omega_values(last + 1, point)  # the frequency through ω_{N+1}
+            eta = self._gauge_values(epsilon)
+            times = np.asarray(t, dtype=float)
+            frequency = _horner(eta, coefficients)
+            message = self._range_message(epsilon, point, values) or self._series_message(
+                coefficients[: last + 1], last, eta, point, coefficients[last + 1])
+            if message is None:
+                message = self._drift_message(coefficients, last, eta, times, point)
+            if message:
+                warn_caller(ExpansionValidityWarning(message))
+            phase = _horner(eta, self._phase_values(point)) if self.problem.has_initial_velocity else None
+            layout = self._waveform_layout
+            data = self._waveform_data(point, float(np.max(np.abs(eta))) if eta.size else 0.0)  # accurate for the largest |η|
+        # floats only from here: the waveform over the times runs lock-free (numpy releases the GIL on large arrays)
+        strained = times * frequency if phase is None else times * frequency + phase
         scaled = data.scale ** (1 / self._steps) * eta
         result = data.amplitude * layout.evaluate(data, strained, scaled, derivative)
         if derivative:
@@ -1393,7 +1394,7 @@ class Expansion:
             bad = np.broadcast_to(~(np.sum(powers * errors, axis=0) <= _WAVEFORM_TOLERANCE), point.shape)
             missing = [int(index) for index in np.flatnonzero(bad) if int(index) not in repaired]
             if missing:
-                values = values.copy() if not repaired else values
+                values = values.copy()  # never in place: a lock-free evaluation may be reading the last data
                 flat = values.reshape(len(layout.expressions), -1)
                 for index in missing:
                     flat[:, index] = [self._exact_at(expression, point, index) for expression in layout.expressions]
