@@ -165,7 +165,7 @@ def _locked_member(owner: type, name: str, member: Any) -> Any:
     if isinstance(member, classmethod):
         return classmethod(locked(member.__func__))
     if isinstance(member, functools.cached_property):  # computed once, then read from the instance lock-free
-        wrapped = type(member)(locked(member.func))
+        wrapped = cached_property(locked(member.func))  # never functools' (its class-wide lock, Python <= 3.11)
         wrapped.__set_name__(owner, name)
         return wrapped
     if isinstance(member, property):
