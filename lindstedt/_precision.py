@@ -23,10 +23,15 @@ derivations, the results' symbolic views and exports, code generation, the refer
 numerical integrators, and the float evaluators of a result once their data is compiled: :func:`locked_methods`
 names them, and each takes the lock itself on its slow path (``tests/test_threads.py`` records every change of
 mpmath's precision made without the lock over a representative set of public calls: there is none).
+User code that evaluates sympy numbers or sets mpmath's precision beside lindstedt's threads holds
+:func:`precision_lock` (the same lock, public).  A lock wrapper is a frame between the user and a warning:
+:func:`warn_caller` attributes the results' warnings to the user's line all the same.
 
 A single lock cannot deadlock against itself (re-entrant, and nothing taken inside it waits for another
-thread's lock), and costs nothing measurable: derivation is bound to the GIL anyway, and the compiled
-float evaluators of the results never take it.  :class:`cached_property` is ``functools.cached_property``
+thread's lock: the functions that run tasks on an executor hold it only in their tasks' sympy steps), and
+costs about 0.2 µs uncontended: derivation is bound to the GIL anyway, and the float paths never take it
+(``Expansion.frequency``'s scalar fast path; ``displacement`` and ``velocity`` evaluate the waveform over
+the times outside it).  :class:`cached_property` is ``functools.cached_property``
 without the per-class lock that Python ≤ 3.11 holds while computing (shared by every instance: a
 computation that takes :data:`LOCK` under it deadlocks against a thread holding :data:`LOCK` that reads
 the same property of another instance); a value computed twice by two threads is the same value.
