@@ -938,8 +938,8 @@ class Expansion:
         expansion was derived for, and ``radius``, the distance to the nearest singularity of ω(ε) the law gives
         (see :mod:`lindstedt.results.orbit_range`).
 
-        None where it is not computed: non-polynomial pieces (fractional or analytic contact laws, smooth f
-        such as sin u), a release shifted by ε a1, and the "harmonic" normalization.
+        Computed for every law (pieces that are not polynomials — sin u, Hertz — numerically, their radius from
+        the real events only); None for a release shifted by ε a1 and the "harmonic" normalization.
 
         The evaluators (:meth:`frequency`, :meth:`displacement`, :meth:`velocity`, the error estimates) raise
         a :class:`~lindstedt.ParameterError` at an ε where no periodic orbit exists (the motion escapes over a
