@@ -213,7 +213,7 @@ def geometric_tail(coefficients: Sequence[float], last: int, eta: Any, safety: f
     """(estimate of |Σ_{k>last} ω_k η^k|, radius in η) from ``coefficients`` ω_0 … ω_{last+1} (vectorised over η).
 
     With G the fastest growth (|ω_k|/|ω_j|)^{1/(k−j)} among ω_1 … ω_{last+1} (ω_0, the linear frequency, sets
-    no growth), ρ = 1/(``safety`` G) is the estimated radius and q = |η|/ρ; the estimate is the first neglected
+    no growth; sizes below 1e-12 of the largest are numerical zeros and set none either), ρ = 1/(``safety`` G) is the estimated radius and q = |η|/ρ; the estimate is the first neglected
     term plus the envelope B q^k of the later ones summed, B = max_j |ω_j| (safety G)^{−j}:
 
         |ω_{n+1}| |η|^{n+1} + B q^{n+2}/(1 − q),
@@ -228,6 +228,11 @@ def geometric_tail(coefficients: Sequence[float], last: int, eta: Any, safety: f
     (2.0, True)
     """
     sizes = [abs(float(value)) for value in coefficients[1 : last + 2]]
+    # A numerical zero (an exact zero computed in floating point: the N-dof hierarchy carries ~1e-17 absolute noise,
+    # e.g. omega_3 = -1.5e-17 at a grazing spring) is no pivot for a growth rate: 0.25/1.5e-17 "grew" 1e16-fold and
+    # put the radius at 1e-16.  Sizes below 1e-12 of the largest are zeros.
+    floor = 1e-12 * max(sizes, default=0.0)
+    sizes = [value if value > floor else 0.0 for value in sizes]
     pairs = [(sizes[k] / sizes[j]) ** (1.0 / (k - j)) for j in range(len(sizes)) for k in range(j + 1, len(sizes)) if sizes[j] > 0 and sizes[k] > 0]
     size = np.abs(np.asarray(eta, dtype=float))
     first = sizes[-1] * size ** (last + 1) if sizes else np.zeros_like(size)
