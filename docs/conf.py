@@ -84,7 +84,8 @@ def setup(app):
 
 
 project = "lindstedt"
-author = "the lindstedt developers"
+author = "The lindstedt maintainers"
+copyright = "2026, The lindstedt maintainers (MIT licence)"
 extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.napoleon",
