@@ -41,11 +41,14 @@ from decimal import Decimal
 from fractions import Fraction
 from typing import Any, Callable, Mapping
 
+import numpy as np
 import sympy
 
 from .._errors import ParameterError, ProblemError
+from .._precision import LOCK, locked
 
-__all__ = ["ALLOWED_FUNCTIONS", "CONSTANTS", "LIMITS", "ParserLimits", "as_exact", "parse_expression", "parse_float", "parse_real", "parse_value"]
+__all__ = ["ALLOWED_FUNCTIONS", "CONSTANTS", "LIMITS", "ParserLimits", "as_exact", "parse_expression", "parse_float", "parse_floats",
+           "parse_real", "parse_value"]
 
 
 @dataclass(frozen=True)
@@ -65,7 +68,10 @@ class ParserLimits:
     decimal_exponent : int
         |e| of a literal ``…e±e``.
     power : int
-        |p| and q of an exponent p/q of a power whose base is not a plain rational.
+        |p| and q of an exponent p/q of a power whose base is not a plain rational, |x| of an irrational
+        numeric exponent x, and the degree of the expression *after* sympy combines powers
+        (``(u**a)**b`` is ``u**(a*b)``, ``u**a * u**b`` is ``u**(a+b)``): in each symbol, exponents of
+        nested powers multiply, those of factors add.
     bits : int
         Bits of numerator plus denominator of any exact rational built.
     """
@@ -163,6 +169,83 @@ def _check_size(value: Any, what: str, text: str) -> None:
         )
 
 
+def _degrees(expression: sympy.Basic, cache: dict[sympy.Basic, dict[sympy.Symbol, Fraction]]) -> dict[sympy.Symbol, Fraction]:
+    """The degree of ``expression`` in each of its free symbols, as sympy holds it: exponents of nested powers
+    multiply, those of factors add, a sum or a function takes the largest of its arguments'."""
+    known = cache.get(expression)
+    if known is not None:
+        return known
+    if not expression.free_symbols:
+        degrees: dict[sympy.Symbol, Fraction] = {}
+    elif expression.is_Symbol:
+        degrees = {expression: Fraction(1)}
+    elif expression.is_Mul:
+        degrees = {}
+        for argument in expression.args:
+            for symbol, degree in _degrees(argument, cache).items():
+                degrees[symbol] = degrees.get(symbol, Fraction(0)) + degree
+    elif expression.is_Pow and not expression.exp.free_symbols:
+        exponent = expression.exp
+        if exponent.is_Rational:
+            factor = abs(Fraction(int(exponent.p), int(exponent.q)))
+        else:  # an irrational number, bounded by LIMITS.power where it was built
+            with LOCK:
+                factor = Fraction(math.ceil(abs(complex(sympy.N(exponent, 15)))))
+        degrees = {symbol: degree * factor for symbol, degree in _degrees(expression.base, cache).items()}
+    else:
+        degrees = {}
+        for argument in expression.args:
+            for symbol, degree in _degrees(argument, cache).items():
+                degrees[symbol] = max(degrees.get(symbol, Fraction(0)), degree)
+    cache[expression] = degrees
+    return degrees
+
+
+def _check_degree(expression: sympy.Basic, what: str, text: str, cache: dict[sympy.Basic, dict[sympy.Symbol, Fraction]]) -> None:
+    for part in (expression, *expression.args) if expression.is_Mul else (expression,):
+        if part.is_Pow and part.exp.is_Rational and part.exp.q > LIMITS.power and part.base.free_symbols:
+            raise ProblemError(
+                f"{what} = {text!r} holds {part} once sympy combines its powers ((u**a)**b is u**(a*b)): exponents are "
+                f"bounded by {LIMITS.power} in numerator and denominator; write it with smaller exponents"
+            )
+    for symbol, degree in _degrees(expression, cache).items():
+        if degree > LIMITS.power:
+            raise ProblemError(
+                f"{what} = {text!r} has degree {degree} in {symbol} once sympy combines its powers "
+                f"((u**a)**b is u**(a*b), u**a*u**b is u**(a+b)), more than the bound of {LIMITS.power}; "
+                "write it with smaller exponents"
+            )
+
+
+def _not_real(expression: sympy.Expr) -> str | None:
+    """``None`` for a real number, else its value (a numeric expression without free symbols: checked by sympy's
+    assumptions, else by a 30-digit evaluation, under the package's lock)."""
+    if expression.is_Rational:
+        return None
+    with LOCK:
+        real = expression.is_extended_real
+        if real is True and expression.is_finite is not False:
+            return None
+        value = sympy.N(expression, 30, chop=True)
+        if real is None and value.is_extended_real and value.is_finite:
+            return None
+        return str(sympy.N(value, 6))
+
+
+def _check_real(expression: sympy.Basic, what: str, text: str, segment: str | None = None) -> None:
+    if not isinstance(expression, sympy.Expr) or expression.free_symbols or not expression.is_number:
+        return
+    value = _not_real(expression)
+    if value is None:
+        return
+    name = segment if segment is not None else str(expression)
+    hint = "keep each function's argument in its real domain (sqrt and fractional powers x >= 0, log x > 0, asin and acos |x| <= 1)"
+    raise ProblemError(
+        f"{what} = {text!r}: the sub-expression {name!r} is not a real number (its value is {value}); "
+        f"lindstedt works with real numbers only: {hint}"
+    )
+
+
 class _Builder:
     """Walks a whitelisted syntax tree and builds the sympy expression bottom-up."""
 
@@ -170,6 +253,13 @@ class _Builder:
         self.text = text
         self.names = names
         self.what = what
+        self.degrees: dict[sympy.Basic, dict[sympy.Symbol, Fraction]] = {}
+
+    def checked(self, result: sympy.Basic, node: ast.AST) -> sympy.Basic:
+        """A built node after sympy's automatic simplification: real if it is a number, of bounded degree."""
+        _check_real(result, self.what, self.text, ast.get_source_segment(self.text, node))
+        _check_degree(result, self.what, self.text, self.degrees)
+        return result
 
     def fail(self, reason: str) -> ProblemError:
         return ProblemError(f"cannot parse {self.what} = {self.text!r}: {reason}; {_GRAMMAR_HINT}")
@@ -200,9 +290,9 @@ class _Builder:
             else:
                 raise self.fail(f"the operator {type(node.op).__name__} is not allowed")
             _check_size(result, self.what, self.text)
-            return result
+            return self.checked(result, node)
         if isinstance(node, ast.Call):
-            return self.call(node, depth)
+            return self.checked(self.call(node, depth), node)
         reason = _FORBIDDEN.get(type(node), f"the construct {type(node).__name__}")
         raise self.fail(f"not allowed: {reason}")
 
@@ -246,6 +336,12 @@ class _Builder:
     def power(self, base: sympy.Expr, exponent: sympy.Expr) -> sympy.Expr:
         if isinstance(exponent, sympy.Rational):
             p, q = abs(int(exponent.p)), int(exponent.q)
+            if isinstance(base, sympy.Rational) and base < 0 and q != 1:
+                raise ProblemError(
+                    f"{self.what} = {self.text!r}: ({base})**({exponent}) is not a real number (sympy takes the principal, "
+                    f"complex root); lindstedt works with real numbers only: for the real root write the sign outside the "
+                    f"power, e.g. -{-base}**({exponent}) or -({-base}**({exponent}))"
+                )
             if isinstance(base, sympy.Rational):
                 if base not in (0, 1, -1) and (q > LIMITS.power or _bits(base) * p > LIMITS.bits * q):
                     raise ProblemError(
@@ -257,11 +353,19 @@ class _Builder:
                     f"{self.what} = {self.text!r}: exponents are bounded by {LIMITS.power} in numerator and denominator, "
                     f"got {exponent}"
                 )
-        elif exponent.is_number and isinstance(base, sympy.Rational):
-            # irrational numeric exponent: sympy keeps 2**pi symbolic, but a huge one would be evaluated later
-            if exponent.has(sympy.zoo, sympy.nan, sympy.oo, -sympy.oo) or abs(sympy.N(exponent, 15)) > LIMITS.power:
-                raise ProblemError(f"{self.what} = {self.text!r}: the exponent {exponent} exceeds the bound {LIMITS.power}")
-        return base**exponent
+        elif exponent.is_number:
+            # irrational numeric exponent: sympy keeps 2**pi or u**pi symbolic, but a huge one would be evaluated later
+            _check_real(exponent, self.what, self.text)
+            with LOCK:
+                if exponent.has(sympy.zoo, sympy.nan, sympy.oo, -sympy.oo) or not abs(sympy.N(exponent, 15)) <= LIMITS.power:
+                    raise ProblemError(f"{self.what} = {self.text!r}: the exponent {exponent} exceeds the bound {LIMITS.power}")
+        result = base**exponent
+        if result.is_number and not isinstance(result, sympy.Rational):  # E**x, pi**x: of moderate size, as function values
+            with LOCK:
+                magnitude = abs(sympy.N(result, 15))
+            if magnitude.has(sympy.nan, sympy.zoo, sympy.oo) or magnitude > _LARGEST:
+                raise ProblemError(f"{self.what} = {self.text!r}: the power {base}**({exponent}) is not a finite number of moderate size")
+        return result
 
     def call(self, node: ast.Call, depth: int) -> sympy.Expr:
         if not isinstance(node.func, ast.Name) or node.func.id not in ALLOWED_FUNCTIONS:
@@ -319,6 +423,7 @@ class _Builder:
             raise self.fail(f"Piecewise{tuple(pieces)} cannot be formed ({error})") from None
 
 
+@locked
 def parse_expression(
     text: str | sympy.Expr | int | float,
     *,
@@ -365,6 +470,10 @@ def parse_expression(
         if isinstance(text, bool) or not isinstance(text, (sympy.Basic, numbers.Number, Decimal)):
             raise ProblemError(f"{what} must be a string or a sympy expression, got {type(text).__name__}")
         expression = as_exact(text, what=what)
+        if isinstance(expression, sympy.Basic):  # the caller's own tree: every numeric sub-expression real, degree bounded
+            for part in sympy.preorder_traversal(expression):
+                _check_real(part, what, str(text))
+            _check_degree(expression, what, str(text), {})
     else:
         expression = _parse_text(text, symbols, what)
     if not isinstance(expression, sympy.Expr):
@@ -438,6 +547,7 @@ def as_exact(value: Any, *, what: str) -> sympy.Expr:
     return number
 
 
+@locked
 def parse_real(value: Any, *, what: str) -> sympy.Expr:
     """A finite real number, exactly: where the API needs a number, this reads it.
 
@@ -506,7 +616,10 @@ def parse_float(value: Any, *, what: str) -> float:
     (0.3333333333333333, 0.25)
     """
     if isinstance(value, (int, float)) and not isinstance(value, bool):
-        number = float(value)
+        try:
+            number = float(value)
+        except OverflowError:
+            raise ProblemError(f"{what} = {value!r} does not fit in a double; give a smaller number") from None
         if not math.isfinite(number):
             raise ProblemError(f"{what} = {value!r} is not finite; give a finite real number")
         return number
@@ -515,6 +628,51 @@ def parse_float(value: Any, *, what: str) -> float:
     if not math.isfinite(number):
         raise ProblemError(f"{what} = {value!r} does not fit in a double; give a smaller number")
     return number
+
+
+def parse_floats(value: Any, *, what: str, scalar: bool = False) -> Any:
+    """ε or t where the API is vectorised: a float or an int as it is (the fast path), an array (or list) of finite
+    real numbers as a float array, anything else through :func:`parse_float` (exact strings such as ``"1/10"``).
+
+    None, booleans, NaN, infinities, words and complex numbers are refused with a :class:`ParameterError`, and
+    arrays too where ``scalar`` is true (one number).
+
+    Examples
+    --------
+    >>> parse_floats(0.1, what="epsilon"), parse_floats("1/8", what="epsilon")
+    (0.1, 0.125)
+    >>> parse_floats([0.0, 0.5], what="t")
+    array([0. , 0.5])
+    >>> parse_floats(float("nan"), what="epsilon")
+    Traceback (most recent call last):
+    ...
+    lindstedt._errors.ParameterError: epsilon = nan is not finite; give a finite real number
+    """
+    kind = type(value)
+    if (kind is float or kind is np.float64) and math.isfinite(value):
+        return value
+    try:
+        if isinstance(value, (np.ndarray, list, tuple)):
+            if scalar and np.ndim(value):
+                raise ParameterError(f"{what} must be one number here, got {type(value).__name__} of shape {np.shape(value)}")
+            array = np.asarray(value)
+            if array.dtype.kind in "fiu":
+                array = array.astype(float, copy=False)
+            elif array.dtype.kind in "OU" and array.size <= 10_000:
+                array = np.vectorize(lambda item: parse_float(item, what=what), otypes=[float])(array)
+            else:
+                raise ParameterError(f"{what} must be real numbers, got an array of {array.dtype}")
+            if not np.all(np.isfinite(array)):
+                bad = array[~np.isfinite(array)].flat[0]
+                raise ParameterError(f"{what} holds {bad}, which is not finite; give finite real numbers")
+            return array
+        if isinstance(value, np.generic):
+            value = value.item()
+        return parse_float(value, what=what)
+    except ParameterError:
+        raise
+    except ProblemError as error:
+        raise ParameterError(str(error)) from None
 
 
 parse_number = parse_real  # transitional alias, removed once every caller is updated

@@ -83,7 +83,7 @@ from .orbit_range import OrbitRange, orbit_range, range_function
 from .._errors import OrderError, ParameterError, ProblemError, UnsupportedNonlinearityError
 from ..export.codegen import stable_function
 from ..export.stable import compile_family
-from ..problems.parsing import parse_expression, parse_real
+from ..problems.parsing import parse_expression, parse_floats, parse_real
 from ..export.display import jupyter_latex, labelled_repr, latex_text, shorten
 from ..algebra.branch import Branch, EvaluationPoint
 from ..problems.oscillator import Oscillator, _decided_sign, reduce_quadratic
@@ -836,6 +836,7 @@ class Expansion:
 
     @locked
     def _frequency(self, epsilon: Any, values: Mapping[Any, Any] | None, order: int | None) -> Any:
+        epsilon = parse_floats(epsilon, what="epsilon")
         last = self._steps * (self.order if order is None else order)
         point = self._read(values)
         if point is None:
@@ -894,6 +895,7 @@ class Expansion:
         >>> round(float(e.truncation_error_estimate(0.1)), 12)     # |omega_2| eps^2 = 21/256 * 0.01
         0.0008203125
         """
+        epsilon = parse_floats(epsilon, what="epsilon")
         last = self._steps * (self.order if order is None else order)
         point = self._read(values)
         if point is None:
@@ -918,6 +920,7 @@ class Expansion:
         >>> bool(e.displacement_error_estimate(10.0, 0.01) < 1e-5 < e.displacement_error_estimate(1e6, 0.01))
         True
         """
+        t, epsilon = parse_floats(t, what="t"), parse_floats(epsilon, what="epsilon", scalar=True)
         scale, amplitude, branches = self._float_branches(values)
         last = self._steps * self.order
         eta = float(self._gauge_values(float(epsilon)))
@@ -1073,6 +1076,7 @@ class Expansion:
         return cached[1]
 
     def _evaluate(self, t: Any, epsilon: Any, values: Mapping[Any, Any] | None, derivative: bool) -> Any:
+        t, epsilon = parse_floats(t, what="t"), parse_floats(epsilon, what="epsilon")
         with LOCK:  # the values read, the float data (compiled on first use) and the warnings: sympy on a slow path
             point = self._read(values)
             if point is None or self._stretched_pieces:

@@ -31,6 +31,7 @@ from .accuracy import (
     series_warning,
 )
 from ..problems.nnm import NNMProblem
+from ..problems.parsing import parse_floats
 from ..problems.system import UnilateralSystem
 
 __all__ = ["NNMExpansion"]
@@ -136,7 +137,7 @@ class NNMExpansion:
         >>> "not converging" in str(caught[0].message)
         True
         """
-        eta = self._gauge_values(epsilon)
+        eta = self._gauge_values(parse_floats(epsilon, what="epsilon"))
         message = self._series_message(eta)
         if message:
             warn_caller(ExpansionValidityWarning(message))
@@ -164,7 +165,7 @@ class NNMExpansion:
         >>> float(mode.truncation_error_estimate(0.01)) < 1e-6 < float(mode.truncation_error_estimate(0.1))
         True
         """
-        estimate, _ = self._tail(self._gauge_values(epsilon))
+        estimate, _ = self._tail(self._gauge_values(parse_floats(epsilon, what="epsilon")))
         return estimate if np.ndim(estimate) else float(estimate)
 
     def displacement_error_estimate(self, t: Any, epsilon: float) -> np.ndarray:
@@ -179,6 +180,7 @@ class NNMExpansion:
         >>> bool(mode.displacement_error_estimate(10.0, 0.01) < 1e-4 < mode.displacement_error_estimate(1e7, 0.01))
         True
         """
+        t, epsilon = parse_floats(t, what="t"), parse_floats(epsilon, what="epsilon", scalar=True)
         eta = float(self._gauge_values(float(epsilon)))
         lam = float(self.omega[0])
         scaled = eta * (lam * lam) ** (-1 / self.gauge)
@@ -230,8 +232,8 @@ class NNMExpansion:
         (2, 4, 3)
         """
         lam = float(self.omega[0])
-        times = np.asarray(t, dtype=float)
-        epsilons = np.asarray(epsilon, dtype=float)
+        times = np.asarray(parse_floats(t, what="t"), dtype=float)
+        epsilons = np.asarray(parse_floats(epsilon, what="epsilon"), dtype=float)
         eta = self._gauge_values(epsilons)
         message = self._series_message(eta) or phase_warning(
             float(self._tail(float(np.max(np.abs(eta), initial=0.0)))[0]), times
@@ -275,7 +277,7 @@ class NNMExpansion:
     def release_state(self, epsilon: float) -> np.ndarray:
         """Physical release X(0) = Φ U(0), U_j(0) = a0 + ε a1, U_k(0) = ε a_k (velocities zero)."""
         modes = self.system.modes()
-        modal = np.array([float(a) for a in self.release_modal]) * epsilon
+        modal = np.array([float(a) for a in self.release_modal]) * parse_floats(epsilon, what="epsilon", scalar=True)
         modal[self.mode - 1] += self.a0
         return modes.shapes @ modal
 
