@@ -6,7 +6,9 @@ For a harmonically forced, damped system (one degree of freedom
 ``Π(z0; Ω, s) = z(2πk/Ω)`` (:class:`~lindstedt.numerics._period_map.PeriodMap`, ``z = (X, X')``):
 
 * :func:`forced_periodic_orbit` solves ``Π(z0) − z0 = 0`` by Newton with the exact Jacobian
-  ``∂Π/∂z0 − I`` (the monodromy minus the identity) → :class:`ForcedOrbit` with the Floquet
+  ``∂Π/∂z0 − I`` (the monodromy minus the identity), refuses up front a Ω whose period maps would span too
+  many natural periods (or lie too far above them), and verifies a converged orbit by an independent
+  integration of its period → :class:`ForcedOrbit` with the Floquet
   multipliers (eigenvalues of the monodromy), stability, the extremes, mean and first harmonic of
   every degree of freedom;
 * :func:`frequency_response` follows the branch in Ω (or in the load scale s at fixed Ω) by
@@ -49,6 +51,7 @@ from ._period_map import PeriodMap, PeriodMapValue
 from .forced_results import Bifurcation, ForcedOrbit, FrequencyResponse
 from .results import _repetitions
 from .forced_setup import (
+    _check_cost,
     _check_periods,
     _description,
     _flow_of,
@@ -57,6 +60,7 @@ from .forced_setup import (
     _positive,
     _real,
     _state,
+    _verify,
     forced_flow,
 )
 
@@ -227,7 +231,17 @@ def forced_periodic_orbit(flow: PeriodMap | ForcedOscillator | ForcedSystem, fre
     Returns
     -------
     ForcedOrbit
-        ``success=False`` with the reason when Newton does not converge (never raised).
+        ``success=False`` with the reason when Newton does not converge, or when the converged orbit fails the
+        independent check: one period integrated again by DOP853 at rtol 1e-13 (atol scaled to the orbit)
+        must not move it by more than ``forced_setup.VERIFY_TOL`` = 1e-6 of its size (far above resonance the
+        fixed point amplifies the map's errors by ~(Ω/ω0)²) — never raised.
+
+    Raises
+    ------
+    ParameterError
+        Ω not a positive finite number; or, before any integration, Ω so far below the linear frequencies that
+        one period map spans more than ``forced_setup.MAX_NATURAL_PERIODS`` natural periods, or more than
+        ``forced_setup.MAX_FREQUENCY_RATIO`` above them (the message names the estimate and the way out).
 
     Examples
     --------
@@ -243,6 +257,7 @@ def forced_periodic_orbit(flow: PeriodMap | ForcedOscillator | ForcedSystem, fre
     k = _check_periods(periods)
     scale = _real(forcing_scale, "forcing_scale")
     tol, stability_tol = _positive(tol, "tol"), _positive(stability_tol, "stability_tol")
+    _check_cost(flow, frequency, k)
     count = _Counter(flow, k)
     if initial_state is None:
         z = _linear_guess(flow, frequency, scale)
@@ -274,6 +289,9 @@ def forced_periodic_orbit(flow: PeriodMap | ForcedOscillator | ForcedSystem, fre
         return _orbit(count, z1, frequency, scale, PeriodMapValue(z1 * np.nan), success=False, message=message,
                       iterations=iterations, stability_tol=stability_tol, samples=samples,
                       epsilon=getattr(flow, "epsilon", None))
+    if ok:
+        ok, note = _verify(flow, z1, frequency, scale, k, value.d_state)
+        message = f"{message}; {note}" if ok else f"{note} ({message})"
     return _orbit(count, z1, frequency, scale, value, success=ok, message=message, iterations=iterations,
                   stability_tol=stability_tol, samples=samples, epsilon=getattr(flow, "epsilon", None))
 
@@ -590,7 +608,9 @@ def frequency_response(flow: PeriodMap | ForcedOscillator | ForcedSystem, start:
     Raises
     ------
     ProblemError, ParameterError
-        For invalid arguments (Ω ≤ 0, ``start == stop``, an unknown ``parameter``, …).
+        For invalid arguments (Ω ≤ 0, ``start == stop``, an unknown ``parameter``, …), and before any
+        integration for a range reaching Ω far below or far above the linear frequencies (see
+        :func:`forced_periodic_orbit`).
 
     Examples
     --------
@@ -614,6 +634,9 @@ def frequency_response(flow: PeriodMap | ForcedOscillator | ForcedSystem, start:
         start, stop = check_forcing_frequency(start, "start"), check_forcing_frequency(stop, "stop")
         if frequency is not None:
             raise ProblemError("parameter='frequency' varies Ω: do not also pass frequency=")
+        for end, name in ((min(start, stop), "start" if start < stop else "stop"),
+                          (max(start, stop), "stop" if start < stop else "start")):
+            _check_cost(flow, end, k, name)
         fixed = _real(forcing_scale, "forcing_scale")
         first = forced_periodic_orbit(flow, start, initial_state=initial_state, periods=k, forcing_scale=fixed, tol=tol,
                                       max_iterations=max_iterations, transient_periods=transient_periods,

@@ -42,7 +42,8 @@ class ForcedOrbit(JsonExport):
     Attributes
     ----------
     success : bool
-        True when ``|Π(z0) − z0| ≤ tol · |z0|`` (max norms).
+        True when ``|Π(z0) − z0| ≤ tol · |z0|`` (max norms) and, for :func:`forced_periodic_orbit`, an
+        independent DOP853 integration of the period agrees (``forced_setup.VERIFY_TOL``).
     message : str
     frequency, forcing_scale : float
         Ω and the load scale s.

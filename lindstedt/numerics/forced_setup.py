@@ -6,7 +6,10 @@ The problems ``u'' + 2 ζ ω0 u' + ω0² u + ε f(u) = ε s F cos(Ω t)`` (:clas
 * :func:`forced_flow` — the exact event-driven :class:`~lindstedt.numerics.ForcedFlow` where the law is
   piecewise linear, the DOP853 :class:`~lindstedt.numerics.SmoothForcedFlow` otherwise;
 * the starts of the shooting Newton: the harmonic response of the problem linearised about X = 0, and the
-  first-order multiple-scales steady states ``u ≈ A cos(Ωt − γ)`` near a resonance.
+  first-order multiple-scales steady states ``u ≈ A cos(Ωt − γ)`` near a resonance;
+* the cost check before any integration (:data:`MAX_NATURAL_PERIODS`, :data:`MAX_FREQUENCY_RATIO`: Ω far below or
+  far above the linear frequencies is refused with the estimate) and the independent verification of a
+  converged orbit (:data:`VERIFY_TOL`).
 """
 
 from __future__ import annotations
@@ -22,7 +25,26 @@ from .._precision import locked
 from ..problems.forced import ForcedOscillator, ForcedSystem
 from ._period_map import PeriodMap
 
-__all__ = ["forced_flow"]
+__all__ = ["MAX_FREQUENCY_RATIO", "MAX_NATURAL_PERIODS", "VERIFY_TOL", "forced_flow"]
+
+#: a period map (k forcing periods 2πk/Ω) spanning more than this many natural periods ``k·max(1, ω_max/Ω)`` is
+#: refused before any integration (Ω far below the linear frequencies).  Measured costs per natural period:
+#: DOP853 (SmoothForcedFlow, rtol 1e-12, with sensitivities) ≈ 35 steps ≈ 2.5 ms; the exact ForcedFlow ≈ 2 switches
+#: per breakpoint ≈ 0.2 ms; so the bound is ≈ 2.5 s per DOP853 period map, and Newton takes ~3–10 maps
+MAX_NATURAL_PERIODS = 1000
+#: Ω above this many times the lowest linear frequency is refused: there one period is ≈ I (monodromy
+#: ``≈ I + A·2π/Ω``), so the fixed point ``(I − ∂Π/∂z)⁻¹`` amplifies every rounding error of the map by ~Ω/ω0
+#: — in relative terms about ``rtol·(Ω/ω0)²`` (measured for ``Max(0, u − 1)``, exact flow: 4e-5 at Ω/ω0 = 1e6,
+#: 0.4 at 1e8; the check of :data:`VERIFY_TOL` reports such orbits as failures); the response there is the
+#: inertia-dominated ``u ≈ −εF cos Ωt/Ω²``
+MAX_FREQUENCY_RATIO = 1e6
+#: a converged orbit is verified by a second, independent integration of its period (DOP853 at rtol
+#: :data:`_VERIFY_RTOL` with atol scaled to the orbit): the Newton correction that map asks for,
+#: ``(∂Π/∂z − I)⁻¹ (Π₂(z) − z)``, relative to the orbit's displacements D and velocities D·max(Ω, ω), must be ≤ this
+VERIFY_TOL = 1e-6
+_VERIFY_RTOL = 1e-13
+#: DOP853 steps and seconds per natural period of one period map (the estimate's calibration, see above)
+_STEPS_PER_NATURAL_PERIOD, _SECONDS_PER_NATURAL_PERIOD = 35, 2.5e-3
 
 # --------------------------------------------------------------------------- #
 # the flow of a problem
@@ -66,6 +88,90 @@ def forced_flow(problem: ForcedOscillator | ForcedSystem, epsilon: float) -> Per
         return ForcedFlow(problem, epsilon)
     except UnsupportedNonlinearityError:  # not piecewise linear: integrate
         return SmoothForcedFlow(problem, epsilon)
+
+
+def _linear_frequencies(flow: Any) -> tuple[float, float] | None:
+    """(lowest, highest) frequency of the flow's linear pieces ``ω² = eig(M⁻¹(K + ε·slopes))``; None for a flow
+    that is not one of the package's (nothing is known about its cost)."""
+    problem, eps = getattr(flow, "problem", None), getattr(flow, "epsilon", None)
+    if eps is None:
+        return None
+    try:
+        if isinstance(problem, ForcedOscillator):
+            omega0 = problem.numeric_coefficients()[0]
+            slopes = [0.0]
+            if getattr(flow, "_intervals", None) is not None:
+                slopes += [slope for slope, _ in flow._intervals]
+            elif getattr(flow, "_law", None) is not None:
+                slopes += [float(slope(point)) for _, slope, point in flow._law.pieces]
+            squares = [omega0 * omega0 + eps * slope for slope in slopes]
+        elif isinstance(problem, ForcedSystem):
+            s = problem.system
+            A = np.array(s.A, dtype=float).reshape(-1, s.n_dof)
+            W = np.array(s.W, dtype=float).reshape(s.n_dof, -1)
+            stiffnesses = [s.K] + ([s.K + eps * W @ A] if A.size else [])
+            squares = [float(x) for K in stiffnesses for x in np.linalg.eigvals(np.linalg.solve(s.M, K)).real]
+        else:
+            return None
+    except (LindstedtError, np.linalg.LinAlgError, TypeError, ValueError, OverflowError):
+        return None
+    roots = [math.sqrt(abs(x)) for x in squares if math.isfinite(x) and x != 0.0]
+    return (min(roots), max(roots)) if roots else None
+
+
+def _check_cost(flow: Any, frequency: float, periods: int, name: str = "frequency") -> None:
+    """Refuse, before integrating, a forcing frequency whose period maps cost more than :data:`MAX_NATURAL_PERIODS`
+    natural periods, or that lies more than :data:`MAX_FREQUENCY_RATIO` above the linear frequencies
+    (a :class:`ParameterError` naming the estimate and what to do instead)."""
+    bounds = _linear_frequencies(flow)
+    if bounds is None:
+        return
+    low, high = bounds
+    natural = periods * max(1.0, high / frequency)
+    if natural > MAX_NATURAL_PERIODS:
+        raise ParameterError(
+            f"{name} Ω = {frequency:.3g} is far below the linear frequencies (Ω/ω_max = {frequency / high:.1e}): one "
+            f"period map ({periods} forcing period{'s' * (periods > 1)}) spans ~{natural:.1e} natural periods "
+            f"(~{natural * _STEPS_PER_NATURAL_PERIOD:.1e} DOP853 steps or switches, ~{natural * _SECONDS_PER_NATURAL_PERIOD:.1e} s, "
+            f"and Newton needs several), above the limit of {MAX_NATURAL_PERIODS} natural periods "
+            "(lindstedt.numerics.forced_setup.MAX_NATURAL_PERIODS); for Ω ≪ ω0 the response is quasi-static, the "
+            "static equilibrium under the slowly varying load ε F cos Ωt; choose Ω ≥ "
+            f"{periods * high / MAX_NATURAL_PERIODS:.3g}")
+    if frequency / low > MAX_FREQUENCY_RATIO:
+        raise ParameterError(
+            f"{name} Ω = {frequency:.3g} is far above the linear frequencies (Ω/ω_min = {frequency / low:.1e} > "
+            f"{MAX_FREQUENCY_RATIO:.0e}, lindstedt.numerics.forced_setup.MAX_FREQUENCY_RATIO): one period is ≈ the "
+            f"identity and the periodic orbit is ill-conditioned by ~Ω/ω; the response there is inertia-dominated, "
+            f"u ≈ −ε F cos(Ωt)/Ω² (size ~ε F/Ω²); choose Ω ≤ {MAX_FREQUENCY_RATIO * low:.3g}")
+
+
+def _verify(flow: Any, z: np.ndarray, frequency: float, scale: float, periods: int,
+            monodromy: np.ndarray) -> tuple[bool, str]:
+    """(agrees, note): the orbit z checked by an independent integration of its period (see :data:`VERIFY_TOL`);
+    a flow not of the package, or a reference that cannot run (a sliding motion), is noted, not failed."""
+    from .forced_smooth import SmoothForcedFlow
+
+    problem, eps = getattr(flow, "problem", None), getattr(flow, "epsilon", None)
+    bounds = _linear_frequencies(flow)
+    if not isinstance(problem, (ForcedOscillator, ForcedSystem)) or eps is None or bounds is None:
+        return True, "not verified independently (a flow of unknown kind)"
+    n = len(z) // 2
+    rate = max(frequency, bounds[1])
+    size = max(float(np.max(np.abs(z[:n]))), float(np.max(np.abs(z[n:]))) / rate, 1e-300)
+    try:
+        rtol = min(_VERIFY_RTOL, getattr(flow, "rtol", 1.0) / 10)
+        reference = SmoothForcedFlow(problem, eps, rtol=max(rtol, 2.5e-14), atol=max(rtol, 2.5e-14) * min(size, size * rate))
+        image = reference.period_map(z, frequency, periods=periods, forcing_scale=scale, sensitivity=False).state
+        correction = np.linalg.solve(monodromy - np.eye(len(z)), z - image)
+    except (LindstedtError, np.linalg.LinAlgError) as error:
+        return True, f"not verified independently (the DOP853 check could not run: {error})"
+    error = max(float(np.max(np.abs(correction[:n]))) / size, float(np.max(np.abs(correction[n:]))) / (size * rate))
+    if not math.isfinite(error) or error > VERIFY_TOL:
+        return False, (f"the independent check (one period by DOP853, rtol {reference.rtol:.0e}) moves the orbit by "
+                       f"{error:.1e} of its size (> {VERIFY_TOL:.0e}): the orbit is not trustworthy here"
+                       + (f" (Ω/ω = {frequency / bounds[0]:.1e}: integration and rounding errors are amplified by ~(Ω/ω)²)"
+                          if frequency > 100 * bounds[1] else ""))
+    return True, f"verified by an independent DOP853 period (agrees to {error:.1e})"
 
 
 def _flow_of(flow: Any, epsilon: float | None) -> PeriodMap:
@@ -145,7 +251,7 @@ def _linear_guess(flow: Any, frequency: float, scale: float) -> np.ndarray:
         X = np.linalg.solve(K - frequency**2 * M + 1j * frequency * C, eps * scale * P.astype(complex))
         guess = np.concatenate((X.real, -frequency * X.imag))
         return guess if np.all(np.isfinite(guess)) else np.zeros(flow.dimension)
-    except (LindstedtError, np.linalg.LinAlgError, TypeError, ValueError, AttributeError, IndexError):
+    except (LindstedtError, np.linalg.LinAlgError, TypeError, ValueError, AttributeError, IndexError, OverflowError):
         return np.zeros(flow.dimension)
 
 

@@ -225,6 +225,25 @@ class SmoothForcedFlow:
             raise ProblemError(
                 f"problem must be a ForcedOscillator or a ForcedSystem (lindstedt.problems.forced), got {type(problem).__name__}")
         self.dimension = 2 * self.n_dof
+        from .forced_setup import _linear_frequencies
+
+        self._frequencies = _linear_frequencies(self) or (1.0, 1.0)
+        self._load_size = abs(self._load) if self._scalar else float(np.max(np.abs(self._Pm)))
+
+    def _absolute_tolerances(self, z: np.ndarray, frequency: float, scale: float, sensitivity: bool) -> np.ndarray:
+        """``atol`` per component: ``min(atol, rtol·size)`` with the size of the displacements
+        ``D = max(|X0|, |X0'|/W, ε|s F|/max(Ω², ω_min²))`` and of the velocities ``D·W``, ``W = max(Ω, ω_max)``, so a
+        tiny response (far above resonance, ~εF/Ω²) is integrated to ``rtol`` and not to a fixed ``atol`` larger
+        than itself (the sensitivities keep ``atol``)."""
+        n = self.n_dof
+        low, high = self._frequencies
+        rate = max(frequency, high)
+        size = max(float(np.max(np.abs(z[:n]))), float(np.max(np.abs(z[n:]))) / rate,
+                   abs(self.epsilon * scale) * self._load_size / max(frequency, low) ** 2, 1e-300)
+        tolerances = np.full(self.dimension * (self.dimension + 3) if sensitivity else self.dimension, self.atol)
+        tolerances[:n] = min(self.atol, self.rtol * size)
+        tolerances[n:2 * n] = min(self.atol, self.rtol * size * rate)
+        return tolerances
 
     def __getstate__(self) -> dict[str, Any]:  # picklable for process pools: the lambdified law is rebuilt
         return {key: value for key, value in self.__dict__.items() if key in ("problem", "epsilon", "rtol", "atol",
@@ -355,12 +374,13 @@ class SmoothForcedFlow:
         t, counters = 0.0, {"steps": 0, "evaluations": 0, "arcs": 0, "switches": 0}
         stalled = 0
         samples: list[np.ndarray] = []
+        atol = self._absolute_tolerances(z, frequency, scale, sensitivity)
         while True:
             rhs = self._fields(region, frequency, scale, sensitivity)
             events = self._events(region)
             y0 = np.concatenate((z, Y.reshape(-1))) if sensitivity else z
             window = None if times is None else times[(times >= t) & (times < end)]
-            solution = solve_ivp(rhs, (t, end), y0, method="DOP853", rtol=self.rtol, atol=self.atol,
+            solution = solve_ivp(rhs, (t, end), y0, method="DOP853", rtol=self.rtol, atol=atol,
                                  events=[e for e, _ in events] or None, dense_output=times is not None)
             counters["arcs"] += 1
             counters["steps"] += len(solution.t) - 1
