@@ -268,3 +268,62 @@ def test_a_library_warning_is_one_line_too():
     lines = result.stderr.splitlines()
     assert result.returncode == 1 and lines[-1].startswith("error: ") and "Traceback" not in result.stderr
     assert lines[:-1] and all(line.startswith("warning: ") and line.endswith("(RuntimeWarning)") for line in lines[:-1])
+
+
+# -- issue 23, item 6: output streams, results that overflow a float, pickling ---------------------------------
+
+
+def _run_cli(*arguments, stdout=subprocess.PIPE):
+    return subprocess.run([sys.executable, "-m", "lindstedt", *arguments], stdout=stdout, stderr=subprocess.PIPE,
+                          text=True, timeout=120)
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
+def test_a_full_output_device_is_one_error_line():
+    with open("/dev/full", "w") as full:
+        run = _run_cli("expand", "u**3", "--a0", "1", "--omega0", "1", stdout=full)
+    assert run.returncode == 1
+    assert run.stderr == "error: cannot write output: No space left on device\n"
+
+
+@pytest.mark.parametrize("arguments", [
+    ["derive", "duffing", "--order", "2", "--output", "{blocker}/sub"],
+    ["demo", "--order", "2", "--figure", "{blocker}/x.png"],
+    ["forced", "u**3", "--eps", "0.1", "--from", "0.9", "--to", "1.1", "--figure", "{blocker}/x.png"],
+])
+def test_an_unwritable_output_path_is_one_error_line(tmp_path, arguments):
+    # a path under a regular file can be written by nobody, root included
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    run = _run_cli(*[argument.format(blocker=blocker) for argument in arguments])
+    assert run.returncode == 2, run.stderr
+    assert len(run.stderr.splitlines()) == 1 and run.stderr.startswith("error: ") and "Traceback" not in run.stderr
+    assert "Not a directory" in run.stderr or "not a directory" in run.stderr.lower()
+
+
+def test_to_json_writes_null_for_a_coefficient_beyond_a_float():
+    import dataclasses
+
+    import mpmath
+
+    import lindstedt
+
+    mode = lindstedt.nnm(lindstedt.UnilateralSystem.one_dof(1, a=1, b=0), mode=1, a0=1, order=2)
+    huge = dataclasses.replace(mode, omega=(mode.omega[0], mpmath.mpf("1e400"), mode.omega[2]))
+    data = json.loads(huge.to_json())  # strict JSON: no Infinity
+    # b = 0: the bilinear oscillator, ω(ε) = 2√(1+ε)/(1+√(1+ε)) = 1 + ε/4 − ε²/8 + …, so ω_2 = -1/8 exactly
+    assert data["omega"][1] is None and data["omega"][2] == -0.125
+    assert data["omega_digits"][1].endswith("e+399") or data["omega_digits"][1].endswith("e+400")
+
+
+def test_an_nnm_expansion_pickles_as_its_recipe():
+    import pickle
+
+    import lindstedt
+
+    system = lindstedt.UnilateralSystem(M=[[1, 0], [0, 1]], K=[[2, -1], [-1, 2]], A=[[1, 0]], b=["1/10"])
+    mode = lindstedt.nnm(system, mode=2, a0=1, order=2, precision=40)
+    copy = pickle.loads(pickle.dumps(mode))
+    assert copy.omega == mode.omega and copy.release_modal == mode.release_modal and copy.digits == mode.digits
+    assert copy.problem == mode.problem
+    assert float(copy.frequency(0.01)) == float(mode.frequency(0.01))

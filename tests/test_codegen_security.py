@@ -290,3 +290,52 @@ def test_internal_names_cannot_be_parameter_names():
         lindstedt.expand("u**3 + _index*u**5", order=1, params={"_index": None})
     source = lindstedt.generate_code(lindstedt.expand("u**3 + c*u**5", order=2, params={"c": None}), "frequency", "c").source
     assert "_index" in source and "_common0" in source and " index" not in source
+
+
+# -- issue 23, item 6: stale partial files, ASCII identifiers ------------------------------------------------------
+
+
+@needs_compiler
+@posix_only
+def test_stale_partial_files_of_a_killed_build_are_removed(cache):
+    _code().compile()  # creates the cache
+    stale, fresh = cache / ".partial-killed.so", cache / ".partial-running.so"
+    for path in (stale, fresh):
+        path.write_bytes(b"half a library")
+    hours_ago = os.stat(stale).st_mtime - 2 * 3600
+    os.utime(stale, (hours_ago, hours_ago))
+    assert _code().compile()(0.1) == pytest.approx(EXPECTED, rel=1e-15)
+    assert not stale.exists()
+    assert fresh.exists()  # a concurrent build's file is left alone
+
+
+GREEK = {"α": 0.5, "u03b1": 0.25, "Α": 0.125}  # a non-ASCII name, its mangled form as a name, and a capital
+
+
+@pytest.mark.parametrize("language", ["numpy", "jax", "c", "fortran", "octave", "julia", "rust"])
+def test_generated_identifiers_are_ascii_and_distinct(language):
+    expansion = lindstedt.expand("u**3 + α*u**5 + u03b1*u**7 + Α*u", order=2, params=dict.fromkeys(GREEK))
+    code = lindstedt.generate_code(expansion, "frequency", language)
+    assert code.source.isascii() and all(argument.isascii() for argument in code.arguments)
+    fold = str.lower if language == "fortran" else str
+    assert len({fold(argument) for argument in code.arguments}) == len(code.arguments)
+    # deterministic: the same expansion gives the same code
+    assert lindstedt.generate_code(expansion, "frequency", language).source == code.source
+
+
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_non_ascii_parameter_names_round_trip(language, cache):
+    expansion = lindstedt.expand("u**3 + α*u**5 + u03b1*u**7 + Α*u", order=2, params=dict.fromkeys(GREEK))
+    values = {"a0": 1, "omega0": 1, **GREEK}
+    code = lindstedt.generate_code(expansion, "frequency", language)
+    generated = code.compile()(0.1, *[values[str(symbol)] for symbol in expansion.arguments])
+    np.testing.assert_allclose(generated, expansion.frequency(0.1, values=values), rtol=1e-13, atol=0)
+
+
+@pytest.mark.skipif(shutil.which("gfortran") is None, reason="no gfortran on PATH")
+def test_non_ascii_parameter_names_compile_in_fortran(tmp_path):
+    expansion = lindstedt.expand("u**3 + α*u**5", order=2, params={"α": None})
+    source = tmp_path / "frequency.f90"
+    source.write_text(lindstedt.generate_code(expansion, "frequency", "fortran").source)
+    run = subprocess.run(["gfortran", "-c", str(source), "-o", str(tmp_path / "frequency.o")], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr

@@ -36,6 +36,12 @@ Long commands (``forced`` sweeps, ``nnm --numeric``, ``expand`` from order 10) s
 stderr while they run when it is a terminal (a tqdm bar, if tqdm is installed), and otherwise print one
 summary line there when they succeed (e.g. ``forced: 214 points, 2 folds, 3.1 s``); stdout holds the
 result alone.
+System files (``nnm SYSTEM.json``, ``forced FORCED.json``) are read within limits checked before the work:
+at most ``--max-dof N`` degrees of freedom and ``--max-springs S`` springs (default 100 each), at most
+64·(N + 1)·(N + S + 1) bytes (1.3 MB by default; a file that never ends, such as /dev/zero, is refused after
+that many), arrays and objects nested at most 8 deep; beyond them one ``error:`` line names the limit and
+the option, exit status 2.  An output that cannot be written (a full disk) is one line
+``error: cannot write output: …``, exit status 1.
 Nothing is written to disk unless asked (``derive --output DIR``, ``demo --figure PATH``, ``forced --figure PATH``).
 """
 
@@ -87,6 +93,7 @@ def _parse_parameters(items: Sequence[str]) -> dict[str, str | None]:
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``lindstedt`` command."""
     from .. import __version__
+    from .forced import add_forced_parser, add_size_options
 
     parser = _ArgumentParser(
         prog="lindstedt",
@@ -131,8 +138,7 @@ def build_parser() -> argparse.ArgumentParser:
     nnm.add_argument("--order", type=int, default=2, help="expansion order (default 2)")
     nnm.add_argument("--precision", type=int, default=30, help="decimal digits of the arithmetic (default 30)")
     nnm.add_argument("--format", choices=FORMATS, default="pretty", help=FORMAT_HELP + " (--numeric: pretty, plain and latex print its summary)")
-
-    from .forced import add_forced_parser
+    add_size_options(nnm)
 
     add_forced_parser(commands, FORMATS, FORMAT_HELP)
 
@@ -326,14 +332,13 @@ def _command_nnm(arguments: argparse.Namespace) -> str | tuple[str, int]:
 
     from ..methods.strained_coordinates import nnm
     from ..problems.system import UnilateralSystem
+    from ._files import check_system_size, read_json_file
 
-    try:
-        with open(arguments.system, encoding="utf-8") as handle:
-            data = json.load(handle, parse_constant=_refuse_json_constant)
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as error:
-        raise ProblemError(f"cannot read the system file {arguments.system!r}: {error}") from None
+    limits = {"max_dof": arguments.max_dof, "max_springs": arguments.max_springs}
+    data = read_json_file(arguments.system, "system file", **limits)
     if not isinstance(data, dict):
         raise ProblemError(f"the system file {arguments.system!r} must hold a JSON object with keys M, K, A, b (and optional W)")
+    check_system_size(data, "system file", **limits)
     system = UnilateralSystem.from_json_dict(data)
     if arguments.numeric:
         return _numeric_nnm(system, arguments)
@@ -364,10 +369,6 @@ def _command_nnm(arguments: argparse.Namespace) -> str | tuple[str, int]:
         return text if value is None else text + f"\nω(ε = {epsilon!r}) = {value!r}"
     text = result.summary()
     return text if value is None else text + f"\nomega({epsilon!r}) = {value!r}"
-
-
-def _refuse_json_constant(name: str) -> None:
-    raise ProblemError(f"the system file contains {name}; every entry must be a finite real number")
 
 
 def _command_derive(arguments: argparse.Namespace) -> str | tuple[str, int]:
@@ -486,13 +487,32 @@ def _run(argv: Sequence[str] | None) -> int:
         return _fail(f"internal failure ({type(error).__name__}: {error}); please report it", EXIT_FAILED)
     try:
         print(output)
+        sys.stdout.flush()  # a full disk (/dev/full) fails here, not at the interpreter's exit
     except BrokenPipeError:  # e.g. `lindstedt expand ... | head`
+        _discard_stdout()
         sys.stderr.close()
     except UnicodeEncodeError:
         return _fail("the output stream cannot encode Unicode; use --format plain (or set PYTHONIOENCODING=utf-8)", EXIT_BAD_INPUT)
+    except OSError as error:  # e.g. no space left on the device stdout writes to
+        _discard_stdout()
+        return _fail(f"cannot write output: {error.strerror or error}", EXIT_FAILED)
     if status and output:
         print("error: the computation did not succeed (see its message above)", file=sys.stderr)
     return status
+
+
+def _discard_stdout() -> None:
+    """Point stdout at /dev/null, so that the interpreter's flush at exit of what could not be written is silent."""
+    import os
+
+    try:
+        sys.stdout.flush()
+    except OSError:
+        pass
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):  # no file descriptor (stdout replaced, e.g. under pytest)
+        pass
 
 
 def _fail(error: Any, status: int) -> int:

@@ -16,7 +16,7 @@ from typing import Any
 from .._errors import LindstedtError, ProblemError
 from ._progress import Progress
 
-__all__ = ["add_forced_parser", "run_forced"]
+__all__ = ["add_forced_parser", "add_size_options", "run_forced"]
 
 #: rows of a text table (ends, bifurcations and evenly spaced points)
 TABLE_ROWS = 24
@@ -44,6 +44,17 @@ def add_forced_parser(commands: Any, formats: tuple[str, ...], format_help: str)
     forced.add_argument("--format", choices=formats, default="pretty", help=format_help)
     forced.add_argument("--figure", default=None, metavar="PATH",
                         help="also draw the response into PATH (matplotlib; .png, .svg, .pdf...) (default: write nothing)")
+    add_size_options(forced)
+
+
+def add_size_options(command: Any) -> None:
+    """``--max-dof`` and ``--max-springs``: the largest system a JSON file may hold (see ``_files``)."""
+    from ._files import MAX_DOF, MAX_SPRINGS
+
+    command.add_argument("--max-dof", type=int, default=MAX_DOF, metavar="N",
+                         help=f"refuse system files of more than N degrees of freedom (default {MAX_DOF})")
+    command.add_argument("--max-springs", type=int, default=MAX_SPRINGS, metavar="S",
+                         help=f"refuse system files of more than S unilateral springs (default {MAX_SPRINGS})")
 
 
 def _problem(arguments: argparse.Namespace, parameters: dict[str, Any]) -> Any:
@@ -54,18 +65,15 @@ def _problem(arguments: argparse.Namespace, parameters: dict[str, Any]) -> Any:
                                               ("--forcing", arguments.forcing != "1"), ("--param", parameters)) if value]
         if given:
             raise ProblemError(f"{', '.join(given)} describe a 1-dof problem; a FORCED.json file holds its own damping and load")
-        try:
-            with open(arguments.f, encoding="utf-8") as handle:
-                data = json.load(handle, parse_constant=_refuse_constant)
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as error:
-            raise ProblemError(f"cannot read the forced system file {arguments.f!r}: {error}") from None
+        from ._files import check_system_size, read_json_file
+
+        limits = {"max_dof": arguments.max_dof, "max_springs": arguments.max_springs}
+        data = read_json_file(arguments.f, "forced system file", **limits)
+        if isinstance(data, dict):
+            check_system_size(data.get("system"), "forced system file", **limits)
         return ForcedSystem.from_json_dict(data)
     return ForcedOscillator(arguments.f, omega0=arguments.omega0, zeta=arguments.zeta, forcing=arguments.forcing,
                             params=parameters)
-
-
-def _refuse_constant(name: str) -> None:
-    raise ProblemError(f"the forced system file contains {name}; every entry must be a finite real number")
 
 
 def _frequencies(arguments: argparse.Namespace) -> tuple[float | None, float | None, float | None]:

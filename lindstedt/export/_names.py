@@ -45,9 +45,11 @@ def _safe_names(
 ) -> dict[sympy.Symbol, sympy.Symbol]:
     """Map each argument to a symbol whose name is not in ``reserved`` nor taken by another argument.
 
-    Free names are kept; the others get ``_`` appended until they are free
+    Free ASCII names are kept; the others get ``_`` appended until they are free
     (``double`` -> ``double_``, or ``double__`` if ``double_`` is an argument too).  Names are compared
-    after ``fold`` (``str.lower`` for Fortran, whose names are case-insensitive).
+    after ``fold`` (``str.lower`` for Fortran, whose names are case-insensitive).  Every generated name is
+    ASCII (Fortran, Octave and some Python tools take no other): a non-ASCII character becomes ``u`` and its
+    code point in hex (``α`` -> ``u03b1``, ``κ_2`` -> ``u03ba_2``), then the same ``_`` rule keeps it distinct.
     """
     if len(set(arguments)) != len(arguments):
         twice = sorted({str(a) for a in arguments if arguments.count(a) > 1})
@@ -58,14 +60,19 @@ def _safe_names(
     taken: set[str] = set()
     names: dict[sympy.Symbol, str] = {}
     for symbol in arguments:
-        if fold(symbol.name) not in reserved and fold(symbol.name) not in taken:
+        if symbol.name.isascii() and fold(symbol.name) not in reserved and fold(symbol.name) not in taken:
             names[symbol] = symbol.name
             taken.add(fold(symbol.name))
     for symbol in arguments:
         if symbol not in names:
-            name = symbol.name
+            name = _ascii(symbol.name)
             while fold(name) in reserved or fold(name) in taken:
                 name += "_"
             names[symbol] = name
             taken.add(fold(name))
     return {s: s if n == s.name else sympy.Symbol(n, **s.assumptions0) for s, n in names.items()}
+
+
+def _ascii(name: str) -> str:
+    """``name`` with each non-ASCII character written ``u`` + its code point in hex (``α`` -> ``u03b1``)."""
+    return "".join(character if character.isascii() else f"u{ord(character):04x}" for character in name)

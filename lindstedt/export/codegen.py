@@ -268,7 +268,7 @@ def generate_code(expansion: Any, quantity: str = "frequency", language: str = "
 
 _UNANALYSED = (
     "not analysed: the closed form is printed as it is (Horner form, 25-digit constants), so float64 rounding "
-    "is amplified by any cancellation in it (e.g. a gap near ±a0 can cost all digits); no bound is claimed"
+    "is amplified by any cancellation in it (e.g. a gap near +-a0 can cost all digits); no bound is claimed"
 )
 
 
@@ -547,7 +547,29 @@ def _cache_directory() -> str:
                 f"the code cache directory {directory} is accessible to other users (mode {stat.S_IMODE(status.st_mode):o}), "
                 f"so compiled code in it is not loaded; {fix}"
             )
+        _remove_stale_partials(directory)
     return directory
+
+
+#: a temporary ``.partial-*`` file of the cache older than this (seconds) is left by a killed build; no compile
+#: of a generated function takes a minute, so an hour is a safe margin for a concurrent build in progress
+STALE_PARTIAL_AGE = 3600.0
+
+
+def _remove_stale_partials(directory: str) -> None:
+    """Delete the ``.partial-*`` files of a killed build: our own regular files older than STALE_PARTIAL_AGE."""
+    import time
+
+    now = time.time()
+    try:
+        entries = [entry for entry in os.scandir(directory) if entry.name.startswith(".partial-")]
+    except OSError:
+        return
+    for entry in entries:
+        with contextlib.suppress(OSError):
+            status = entry.stat(follow_symlinks=False)
+            if stat.S_ISREG(status.st_mode) and status.st_uid == os.getuid() and now - status.st_mtime > STALE_PARTIAL_AGE:
+                os.unlink(entry.path)
 
 
 def _write_atomically(path: str, data: bytes) -> None:

@@ -64,14 +64,17 @@ __all__ = ["JsonExport", "exported_fields", "finite_float", "to_jsonable"]
 
 
 def finite_float(value: Any) -> float | None:
-    """``float(value)``, or ``None`` when it is NaN or infinite (JSON has no such numbers).
+    """``float(value)``, or ``None`` when it is NaN, infinite or beyond a float's range (JSON has no such numbers).
 
     Examples
     --------
-    >>> finite_float(2), finite_float(float("nan")), finite_float(-float("inf"))
-    (2.0, None, None)
+    >>> finite_float(2), finite_float(float("nan")), finite_float(-float("inf")), finite_float(10**400)
+    (2.0, None, None, None)
     """
-    number = float(value)
+    try:
+        number = float(value)
+    except OverflowError:  # an exact integer or rational beyond 1.8e308
+        return None
     return number if math.isfinite(number) else None
 
 

@@ -83,6 +83,12 @@ class StrainedCoordinatesNNM:
 
 
 @locked
+def _rebuild_nnm(problem: NNMProblem, order: int, digits: int) -> NNMExpansion:
+    """An unpickled :class:`~lindstedt.NNMExpansion`: derived again from its recipe (see ``NNMExpansion.__reduce__``)."""
+    precision = digits - modal_guard_digits(problem.system, problem.mode - 1, order)
+    return StrainedCoordinatesNNM(precision).expand(problem, order)
+
+
 def release_amplitudes_by_series(system: UnilateralSystem, mode: int, a0: Any, *, precision: int = 30) -> list[tuple[Any, Any]]:
     """The a_k (k ≠ j) of Corollary 4.2 as Fourier series, summed by mpmath with an error estimate.
 

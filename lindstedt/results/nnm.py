@@ -18,6 +18,7 @@ import mpmath
 import numpy as np
 import sympy
 
+from ..export.json import finite_float
 from ..export.display import DIGITS, format_number, format_vector, jupyter_latex, labelled_repr
 from ..engine.branches import BranchHierarchy, FloatBranches, fold
 from .accuracy import (
@@ -92,6 +93,20 @@ class NNMExpansion:
     small_divisors: tuple[tuple[int, int, float], ...]
     gauge: int
     _hierarchy: BranchHierarchy = field(repr=False, compare=False)
+
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        """Pickled as its recipe (problem, order, working digits): the receiving process derives it again.
+
+        Examples
+        --------
+        >>> import pickle, lindstedt
+        >>> mode = lindstedt.nnm(lindstedt.UnilateralSystem.one_dof(1, a=1, b=0), mode=1, a0=1, order=2)
+        >>> pickle.loads(pickle.dumps(mode)).omega == mode.omega
+        True
+        """
+        from ..methods.strained_coordinates import _rebuild_nnm
+
+        return _rebuild_nnm, (self.problem, self.order, self.digits)
 
     @property
     def system(self) -> UnilateralSystem:
@@ -291,10 +306,10 @@ class NNMExpansion:
             "order": self.order,
             "gauge": "epsilon" if self.gauge == 1 else "sqrt(epsilon)",
             "lambda": list(self.lambdas),
-            "omega": [float(w) for w in self.omega],
+            "omega": [finite_float(w) for w in self.omega],  # null beyond a float's range (omega_digits keeps it)
             "omega_digits": [mpmath.nstr(w, self.digits) for w in self.omega],
-            "alpha": [float(a) for a in self.alpha],
-            "a_k": [float(a) for a in self.a_k],
+            "alpha": [finite_float(a) for a in self.alpha],
+            "a_k": [finite_float(a) for a in self.a_k],
             "validity": {"exponent": str(self.validity_exponent), "spring_roots": list(self.spring_roots)},
             "small_divisors": [{"mode": k, "harmonic": n, "divisor": d} for k, n, d in self.small_divisors],
         }
