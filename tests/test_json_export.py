@@ -149,3 +149,13 @@ def test_nnm_numeric_schema_unchanged(results):
         "residual", "n_switches", "formulation", "newton_iterations", "flow_evaluations",
     ]
     assert data["floquet_multipliers"] == [[float(z.real), float(z.imag)] for z in point.floquet_multipliers]
+
+
+def test_expansion_json_writes_null_for_a_coefficient_beyond_a_float():
+    """a0 = 10^200: ω_1 = 3 a0²/8 = 3.75e399 overflows a double; the exact value stays, its float is null."""
+    expansion = lindstedt.expand("u**3", order=2, a0=10**200, omega0=1)
+    data = json.loads(expansion.to_json())
+    assert data["omega_float"] == [1.0, None, None]
+    assert "Infinity" not in expansion.to_json() and "NaN" not in expansion.to_json()
+    exact = lindstedt.expand("u**3", order=2, a0=1, omega0=1).to_dict()["omega_float"]
+    assert exact == [1.0, 0.375, -21 / 256]

@@ -84,6 +84,7 @@ from .._errors import OrderError, ParameterError, ProblemError, UnsupportedNonli
 from ..export.codegen import stable_function
 from ..export.stable import compile_family
 from ..problems.parsing import parse_expression, parse_floats, parse_real
+from ..export.json import finite_float
 from ..export.display import jupyter_latex, labelled_repr, latex_text, shorten
 from ..algebra.branch import Branch, EvaluationPoint
 from ..problems.oscillator import Oscillator, _decided_sign, reduce_quadratic
@@ -206,9 +207,8 @@ def _assumption_latex(text: str, symbols: Mapping[str, sympy.Symbol]) -> str:
 
 @locked
 def _as_float(expression: sympy.Expr) -> float | None:
-    if expression.free_symbols:
-        return None
-    return float(expression)
+    """The float of a numeric coefficient for JSON; None when symbolic, or beyond a float's range (JSON has no inf)."""
+    return None if expression.free_symbols else finite_float(expression)
 
 
 @locked  # sympy's evalf of acos, … sets mpmath's process-wide precision
