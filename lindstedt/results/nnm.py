@@ -161,10 +161,15 @@ class NNMExpansion:
     def _series_message(self, eta: np.ndarray) -> str | None:
         last = len(self.omega) - 1
         return series_warning(self._coefficients, last, np.atleast_1d(eta), self._gauge_name) or radius_warning(
-            self._tail(eta)[1], eta, self._gauge_name, last)
+            self._radius, eta, self._gauge_name, last)
 
     def _tail(self, eta: Any) -> tuple[np.ndarray, float]:
         return geometric_tail(self._coefficients, len(self.omega) - 1, eta)
+
+    @cached_property
+    def _radius(self) -> float:
+        """The radius of convergence in η that :func:`geometric_tail` estimates (it depends on the coefficients only)."""
+        return self._tail(0.0)[1]
 
     def truncation_error_estimate(self, epsilon: Any) -> Any:
         """Estimated ``|ω(ε) − Σ_{k≤n} ω_k η^k|`` (vectorised): the first neglected term ``|ω_{n+1} η^{n+1}|`` plus
