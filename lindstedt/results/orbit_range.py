@@ -312,9 +312,7 @@ class OrbitRange:
     radius_reason: str
     _edges: np.ndarray = field(repr=False, compare=False)
     _states: Callable[[int], Any] = field(repr=False, compare=False)  # interval between edges -> frozenset or reason str
-    _reference: Any = field(repr=False, compare=False)
     _exact: Any = field(repr=False, compare=False)  # ε -> state (for ε exactly on an edge)
-    _breakpoints: tuple[float, ...] = field(repr=False, compare=False)
 
     def state(self, epsilon: float) -> Any:
         """The orbit's regime at ε: the frozenset of indices of the crossed breakpoints, or the reason (str) that
@@ -709,12 +707,4 @@ def orbit_range(omega0: float, u0: float, v0: float, pieces: tuple[tuple[Any, ..
     for value, text in complex_events:
         if abs(value) < radius:
             radius, radius_reason = abs(value), text
-    exact = {float(edge): None for edge in edges}
-
-    def at_edge(epsilon: float) -> Any:
-        if exact.get(epsilon) is None:
-            exact[epsilon] = state(epsilon)
-        return exact[epsilon]
-
-    return OrbitRange(lower, upper, lower_reason, upper_reason, radius, radius_reason, edges, states,
-                      (reference_minus, reference_plus), at_edge, breakpoints)
+    return OrbitRange(lower, upper, lower_reason, upper_reason, radius, radius_reason, edges, states, state)
