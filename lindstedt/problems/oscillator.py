@@ -39,10 +39,11 @@ is ``u(t) = v(ω t + φ(ε); ε)`` with the phase φ of :class:`~lindstedt.Expan
 from __future__ import annotations
 
 import copy
+import difflib
 import keyword
 import math
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import sympy
 
@@ -273,6 +274,29 @@ class _TurningPoint:
             if _decided_sign(self._output(value), "A_n") == 0:
                 value = sympy.Integer(0)
         return value
+
+
+def check_names(values: Mapping[Any, Any], names: Sequence[str]) -> None:
+    """Raise a :class:`~lindstedt.ParameterError` naming a key of ``values`` that is not one of ``names`` (the free
+    symbols), with the closest name as a suggestion.
+
+    Examples
+    --------
+    >>> check_names({"A0": 1}, ("a0", "omega0"))
+    Traceback (most recent call last):
+    ...
+    lindstedt._errors.ParameterError: unknown parameter 'A0'; did you mean 'a0'? (the problem does not have it as a free symbol; its free symbols are a0, omega0)
+    """
+    for key in values:
+        name = key.name if isinstance(key, sympy.Symbol) else str(key)
+        if name in names:
+            continue
+        close = difflib.get_close_matches(name, names, n=1, cutoff=0.5) or [
+            candidate for candidate in names if candidate.lower() == name.lower()]
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        free = f"its free symbols are {', '.join(names)}" if names else "it has none: give no values"
+        raise ParameterError(f"unknown parameter {name!r}{hint} (the problem does not have it as a free symbol; {free})")
+
 
 
 @locked_methods()
@@ -586,15 +610,18 @@ class Oscillator:
         Raises
         ------
         ParameterError
-            If a symbol has no value, naming it and how to pass it.
+            If a symbol has no value, naming it and how to pass it, or a value names no free symbol
+            (:func:`check_names`).
         """
+        symbols = sorted(self.free_symbols, key=str)
+        check_names(values or {}, [symbol.name for symbol in symbols])
         given: dict[str, sympy.Expr] = {}
         for key, value in (values or {}).items():
             name = key.name if isinstance(key, sympy.Symbol) else str(key)
             given[name] = parse_real(value, what=name)
         substitution: dict[sympy.Symbol, sympy.Expr] = {}
         missing = []
-        for symbol in sorted(self.free_symbols, key=str):
+        for symbol in symbols:
             if symbol.name in given:
                 substitution[symbol] = given[symbol.name]
             else:
@@ -604,11 +631,6 @@ class Oscillator:
                 f"a numeric result needs values for {', '.join(missing)}; pass values={{"
                 + ", ".join(f"'{name}': ..." for name in missing)
                 + "} (or give them when building the problem)"
-            )
-        unknown = set(given) - {symbol.name for symbol in self.free_symbols}
-        if unknown:
-            raise ParameterError(
-                f"values given for {', '.join(sorted(unknown))}, which the problem does not have as free symbols; remove them"
             )
         return substitution
 

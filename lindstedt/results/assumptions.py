@@ -13,17 +13,16 @@ naming the regime and the re-derivation when numeric values leave them.
 
 from __future__ import annotations
 
-import difflib
 from dataclasses import dataclass
 from .._precision import cached_property
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Callable, Mapping
 
 import numpy as np
 import sympy
 
 from .._errors import ParameterError
 from ..export.stable import compile_family
-from ..problems.oscillator import Oscillator
+from ..problems.oscillator import Oscillator, check_names
 
 __all__ = ["DerivationAssumptions", "check_names", "shown_values"]
 
@@ -71,28 +70,6 @@ def shown_values(substitution: Mapping[sympy.Symbol, sympy.Expr]) -> str:
     return ", ".join(
         f"{symbol} = {_shown_number(value)}" for symbol, value in sorted(substitution.items(), key=lambda item: item[0].name)
     )
-
-
-def check_names(values: Mapping[Any, Any], names: Sequence[str]) -> None:
-    """Raise a :class:`~lindstedt.ParameterError` naming a key of ``values`` that is not one of ``names`` (the free
-    symbols), with the closest name as a suggestion.
-
-    Examples
-    --------
-    >>> check_names({"A0": 1}, ("a0", "omega0"))
-    Traceback (most recent call last):
-    ...
-    lindstedt._errors.ParameterError: unknown parameter 'A0'; did you mean 'a0'? (the problem does not have it as a free symbol; its free symbols are a0, omega0)
-    """
-    for key in values:
-        name = key.name if isinstance(key, sympy.Symbol) else str(key)
-        if name in names:
-            continue
-        close = difflib.get_close_matches(name, names, n=1, cutoff=0.5) or [
-            candidate for candidate in names if candidate.lower() == name.lower()]
-        hint = f"; did you mean {close[0]!r}?" if close else ""
-        free = f"its free symbols are {', '.join(names)}" if names else "it has none: give no values"
-        raise ParameterError(f"unknown parameter {name!r}{hint} (the problem does not have it as a free symbol; {free})")
 
 
 _POSITIVE, _NEGATIVE, _ZERO, _NONZERO = frozenset({1}), frozenset({-1}), frozenset({0}), frozenset({-1, 1})

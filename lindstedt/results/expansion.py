@@ -783,8 +783,7 @@ class Expansion:
         Checked once per values (cached with the float data): repeated evaluations pay nothing.
         """
         key = ("substitution", self._values_key(values))
-        if key not in self._float_cache:
-            check_names(values or {}, self._argument_names)
+        if key not in self._float_cache:  # numeric_substitution names an unknown value (check_names) or a missing one
             self._float_cache[key] = self._assumptions.check(self.problem.numeric_substitution(values))
         return self._float_cache[key]
 
