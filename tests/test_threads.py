@@ -297,6 +297,8 @@ def _public_calls() -> list:
         out.append(expansion.displacement(times, 0.1, values=values))
         out.append(expansion.velocity(times, 0.1, values=values))
         out.append(expansion.truncation_error_estimate(0.1, values=values))
+    # times and eps given as exact strings: read by the lock-free evaluators' parse_floats (sympy evaluates them)
+    out += [smooth.displacement(["acos(1/3)", 2.0], 0.1), smooth.velocity("asin(1/3)", "1/10"), smooth.frequency("acos(1/3)/10")]
     out += [gap.to_latex(waveforms=True), gap.to_json(), repr(gap), gap.summary(), str(gap.phase), branch.to_latex()]
     out += [gap.lambdify("frequency")(0.1), branch.lambdify("frequency")(0.1, -0.36), smooth.displacement_error_estimate(1.0, 0.1)]
     out += [lindstedt.generate_code(gap, "frequency", "c").source, lindstedt.generate_code(branch, "frequency", "numpy").source]

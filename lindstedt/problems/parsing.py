@@ -623,8 +623,9 @@ def parse_float(value: Any, *, what: str) -> float:
         if not math.isfinite(number):
             raise ProblemError(f"{what} = {value!r} is not finite; give a finite real number")
         return number
-    exact = parse_real(value, what=what)
-    number = float(exact) if isinstance(exact, sympy.Rational) else float(sympy.N(exact, 20))
+    with LOCK:  # sympy evaluates the number through mpmath (parse_floats calls this from lock-free evaluators)
+        exact = parse_real(value, what=what)
+        number = float(exact) if isinstance(exact, sympy.Rational) else float(sympy.N(exact, 20))
     if not math.isfinite(number):
         raise ProblemError(f"{what} = {value!r} does not fit in a double; give a smaller number")
     return number
