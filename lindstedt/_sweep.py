@@ -13,15 +13,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Iterable, Sequence, TypeVar
 
-from ._precision import LOCK
-
-__all__ = ["MPMATH_LOCK", "sweep_map"]
-
-#: mpmath's working precision is one process-wide setting (``mp.dps``): the package changes it only
-#: under this lock (:mod:`lindstedt._precision`, which also guards the lazily grown hierarchies), so on a
-#: thread pool (or a Dask cluster of threads) the mpmath parts of tasks run one at a time, correctly;
-#: process pools and Dask clusters of processes run them in parallel.
-MPMATH_LOCK = LOCK
+__all__ = ["sweep_map"]
 
 Result = TypeVar("Result")
 
@@ -54,8 +46,9 @@ def sweep_map(
     """``[task(v) for v in values]``, on ``executor`` when given, reporting ``progress``.
 
     ``task`` must be picklable for a process pool or a Dask cluster (a module-level function or a
-    ``functools.partial`` of one).  The package's mpmath computations hold :data:`MPMATH_LOCK`, so
-    threads give correct results but little speed-up for them: use processes.
+    ``functools.partial`` of one).  The package's sympy and mpmath computations hold its one lock
+    (:data:`lindstedt._precision.LOCK`: mpmath's working precision is one process-wide setting), so on a thread pool
+    (or a Dask cluster of threads) they run one at a time, correctly, with little speed-up: use processes.
 
     Examples
     --------

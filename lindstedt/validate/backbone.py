@@ -104,7 +104,7 @@ def _amplitude_task(a0: float, *, f: Any, order: int, omega0: Any, params: Any, 
                     precision: int) -> tuple[list[float] | None, float, float, str, str]:
     """(ω_1 … ω_N truncated at ε, exact ω, its estimate, failure text, validity warning) at one amplitude (picklable).
 
-    Safe on threads: the engine and the quadrature hold :data:`lindstedt._sweep.MPMATH_LOCK` where they use mpmath.
+    Safe on threads: the engine and the quadrature hold :data:`lindstedt._precision.LOCK` where they use mpmath.
     """
     from .._errors import LindstedtError
     from ..methods.lindstedt_poincare import expand
