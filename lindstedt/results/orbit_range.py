@@ -325,6 +325,12 @@ class OrbitRange:
     def judge(self, epsilon: Any, gauge: str = "eps") -> str | None:
         """Raise :class:`~lindstedt.ParameterError` where no periodic orbit exists at some ε of ``epsilon``; else the
         warning text for the first ε outside (lower, upper) or beyond the radius, or None."""
+        if isinstance(epsilon, float):  # one ε inside the range and the disc: the common case, decided at once
+            if self.lower < epsilon < self.upper and abs(epsilon) < self.radius:
+                return None
+        elif np.all((np.asarray(epsilon) > self.lower) & (np.asarray(epsilon) < self.upper)
+                    & (np.abs(epsilon) < self.radius)):
+            return None
         points = np.unique(np.asarray(epsilon, dtype=float))
         points = points[np.isfinite(points)]
         outside = points[(points <= self.lower) | (points >= self.upper)]
