@@ -801,11 +801,17 @@ class Expansion:
         Evaluated from float coefficients computed once per expansion and parameter values (compiled
         closed forms for free symbols, accepted only where their rounding-error bound is below 1e-13
         relative; stable series or exact evaluation elsewhere, see :meth:`frequency_coefficients`).
-        Warns (:class:`ExpansionValidityWarning`) where the series stops converging.
+        Judged against :meth:`epsilon_range`: raises :class:`~lindstedt.ParameterError` at an ε where no
+        periodic orbit exists (the motion escapes, a contact piece loses its stiffness, the release point is an
+        equilibrium); warns (:class:`ExpansionValidityWarning`) where the orbit has left the contact regime the
+        expansion was derived for, where ε is beyond the series' radius of convergence, or where its terms stop
+        decreasing.
 
         Parameters
         ----------
         epsilon : float or array
+            Read by the one reading of numbers: exact strings such as ``"1/10"`` are accepted; None, booleans,
+            NaN, infinities, complex numbers and words raise :class:`~lindstedt.ParameterError`.
         values : mapping, optional
             Numbers for the symbols left free (a0, omega0, parameters); float arrays are broadcast
             against ``epsilon`` and each other.  Floats are used as they are; other numbers (ints,
