@@ -17,6 +17,7 @@ mpmath work leaves their results bit-identical to the serial ones (before: a 40-
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import threading
 import warnings
@@ -27,6 +28,24 @@ import pytest
 
 import lindstedt
 from lindstedt.references import duffing_exact_frequency, piecewise_linear_exact_frequency
+
+
+@contextlib.contextmanager
+def _looping_beside(task, outputs: list):
+    """Run ``task`` over and over on a background thread (its results appended to ``outputs``) while the block runs."""
+    stop = threading.Event()
+
+    def loop():
+        while not stop.is_set():
+            outputs.append(task())
+
+    worker = threading.Thread(target=loop)
+    worker.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        worker.join(timeout=600)
 
 THREADS = 20
 ROUNDS = 3
@@ -177,24 +196,13 @@ def test_a_high_precision_thread_does_not_change_another_threads_result(eager_sw
 
     expected, expected_low, expected_high = _bits(_serial(make, evaluate)), low(), high()
     precision = mpmath.mp.prec
-    stop = threading.Event()
     highs: list = []
-
-    def busy():
-        while not stop.is_set():
-            highs.append(high())
-
-    worker = threading.Thread(target=busy)
-    worker.start()
-    try:
+    with _looping_beside(high, highs):
         for _ in range(2):
             lindstedt.clear_cache()
             results = _together(lambda: (evaluate(make()), [low() for _ in range(3)]), count=10)
             assert all(_bits(result) == expected for result, _ in results)
             assert all(value == expected_low for _, values in results for value in values)
-    finally:
-        stop.set()
-        worker.join(timeout=600)
     assert highs and all(value == expected_high for value in highs)
     assert mpmath.mp.prec == precision
 
@@ -366,27 +374,20 @@ def test_sympy_heavy_exports_do_not_disturb_locked_mpmath_work(eager_switching):
         warnings.simplefilter("ignore")
         lindstedt.clear_cache()
         expected_exports, expected_work = sympy_heavy(), mpmath_work()
-    stop = threading.Event()
     exports: list = []
 
-    def exporter():
+    def export_afresh():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            while not stop.is_set():
-                sympy.core.cache.clear_cache()  # sympy evaluates afresh each time
-                exports.append(sympy_heavy())
+            sympy.core.cache.clear_cache()  # sympy evaluates afresh each time
+            return sympy_heavy()
 
-    worker = threading.Thread(target=exporter)
-    worker.start()
-    try:
+    with _looping_beside(export_afresh, exports):
         for _ in range(2):
             lindstedt.clear_cache()
             results = _together(mpmath_work, count=4)
             wrong = [index for index, result in enumerate(results) if _exact(result) != _exact(expected_work)]
             assert not wrong, f"threads {wrong}: {results[wrong[0]]} differ from the serial {expected_work}"
-    finally:
-        stop.set()
-        worker.join(timeout=600)
     assert exports and all(export == expected_exports for export in exports)
     assert mpmath.mp.prec == precision
 
