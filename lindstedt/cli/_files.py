@@ -55,8 +55,10 @@ def read_json_file(path: str, what: str, *, max_dof: int = MAX_DOF, max_springs:
             raise ProblemError(f"{option} must be a positive integer, got {value}")
     limit = size_limit(max_dof, max_springs)
     try:
-        with open(path, "rb") as handle:
-            raw = handle.read(limit + 1)
+        with open(path, "rb") as handle:  # in chunks: a huge limit allocates nothing up front
+            raw = bytearray()
+            while len(raw) <= limit and (chunk := handle.read(min(1 << 20, limit + 1 - len(raw)))):
+                raw += chunk
     except OSError as error:
         raise ProblemError(f"cannot read the {what} {path!r}: {error.strerror or error}") from None
     if len(raw) > limit:
@@ -70,6 +72,9 @@ def read_json_file(path: str, what: str, *, max_dof: int = MAX_DOF, max_springs:
         raise ProblemError(f"the {what} {path!r} is not UTF-8 text: {error}") from None
     except json.JSONDecodeError as error:
         raise ProblemError(f"the {what} {path!r} is not valid JSON: {error}") from None
+    except ValueError as error:  # an integer beyond Python's digit limit (sys.get_int_max_str_digits)
+        raise ProblemError(f"the {what} {path!r} holds a number too long to read ({error}); "
+                           "write every integer with at most 4300 digits") from None
     except RecursionError:
         _too_deep(path, what)
     _check_shape(data, path, what, max(max_dof, max_springs))

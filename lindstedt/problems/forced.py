@@ -17,6 +17,7 @@ of the problem: they are given to the methods (Ω is what a frequency response s
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
@@ -32,6 +33,8 @@ from .system import UnilateralSystem, _exact_matrix, _exact_scalar, _float_array
 __all__ = ["ForcedOscillator", "ForcedSystem", "check_forcing_frequency"]
 
 DAMPING_KINDS = ("rayleigh", "modal", "matrix")
+#: the largest float: ω0, ζ and F beyond it are refused (every forced method computes in floats)
+_FLOAT_MAX = sympy.Float(sys.float_info.max)
 
 
 @locked
@@ -125,6 +128,18 @@ class ForcedOscillator:
                 raise ProblemError(
                     "forcing F = 0 leaves a free damped oscillator; give F ≠ 0, or use lindstedt.expand / "
                     "lindstedt.nnm for free vibrations"
+                )
+        at_rest = free.nonlinearity.subs(free.variable, 0)
+        if at_rest.has(sympy.zoo, sympy.oo, -sympy.oo, sympy.nan):
+            raise ProblemError(
+                f"f = {free.nonlinearity} is not finite at u = 0, where every forced response passes: give f finite "
+                "near u = 0 (a pole or a logarithm there is not a restoring force); shift it, e.g. 1/(u - 2)"
+            )
+        for name, value in (("omega0", free.omega0), ("zeta", zeta), ("forcing", forcing)):
+            if not value.free_symbols and abs(value) > _FLOAT_MAX:
+                raise ParameterError(
+                    f"{name} = {sympy.N(value, 3)} is beyond the range of floating point (|x| < 1.8e308) that the "
+                    f"numerical flows and the steady amplitudes are computed in; rescale the problem (time or amplitude)"
                 )
         set_field(self, "oscillator", free)
         set_field(self, "f", free.f)
