@@ -9,6 +9,8 @@ The public API is re-exported here and in the documented public subpackages:
 * :mod:`lindstedt.algebra` — the exact algebra (cosine series, the contact Fourier
   kernel of ``(cos s − κ)_+`` and ``H(cos s − κ)``);
 * :mod:`lindstedt.numerics` — the exact piecewise-linear flow and NNMs by shooting;
+* :mod:`lindstedt.limits` — bounded work: the budget of a request (time, memory), its cost estimate
+  before it runs, cancellation and progress while it runs;
 * :mod:`lindstedt.plot` — figures on matplotlib (backbone, waveform, spectra, convergence, NNM branches);
 * :mod:`lindstedt.cli` — the ``lindstedt`` command (``python -m lindstedt``).
 
@@ -24,6 +26,8 @@ Examples
 """
 
 from ._errors import (
+    BudgetError,
+    Cancelled,
     ConvergenceError,
     LindstedtError,
     OrderError,
@@ -38,7 +42,7 @@ from ._errors import (
 _LAZY = {
     "methods.all_modes": ("AllModesFirstOrder", "all_modes_first_order"),
     "_precision": ("precision_lock",),
-    "methods.lindstedt_poincare": ("LindstedtPoincare", "cache_info", "clear_cache", "expand"),
+    "methods.lindstedt_poincare": ("LindstedtPoincare", "cache_info", "clear_cache", "expand", "expansion_cost"),
     "export.codegen": ("CodeGenerationError", "GeneratedCode", "generate_code"),
     "algebra.cosine": ("CosineSeries", "SineSeries", "solve_harmonic_oscillator"),
     "results.expansion": ("Expansion", "ExpansionValidityWarning", "PiecewiseWaveform", "Waveform"),
@@ -145,4 +149,7 @@ __all__ = [
     "ResonanceError",
     "ConvergenceError",
     "CodeGenerationError",
+    "BudgetError",
+    "Cancelled",
+    "expansion_cost",
 ]

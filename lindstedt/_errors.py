@@ -11,6 +11,8 @@ wrong and how to fix it.  The hierarchy is deliberately small:
     ``ResonanceError``: an internal resonance makes the expansion undefined.
     ``ConvergenceError``: a numerical method did not reach its tolerance.
     ``CodeGenerationError``: code could not be generated, compiled or loaded.
+    ``BudgetError``: a request costs more than the budget in force (:mod:`lindstedt.limits`).
+    ``Cancelled``: a request was cancelled at one of its checkpoints (:mod:`lindstedt.limits`).
 """
 
 from __future__ import annotations
@@ -24,6 +26,8 @@ __all__ = [
     "ResonanceError",
     "ConvergenceError",
     "CodeGenerationError",
+    "BudgetError",
+    "Cancelled",
 ]
 
 
@@ -57,3 +61,20 @@ class ConvergenceError(LindstedtError):
 
 class CodeGenerationError(LindstedtError):
     """The generated code could not be generated, compiled or loaded (e.g. an unknown target language)."""
+
+
+class BudgetError(LindstedtError):
+    """A request costs more than the budget in force (:mod:`lindstedt.limits`): refused before it starts (its
+    :attr:`estimate` above the budget), or stopped at a checkpoint once the budget was spent."""
+
+    def __init__(self, message: str, estimate: object = None, up_front: bool = False):
+        super().__init__(message)
+        self.estimate = estimate
+        self.up_front = up_front
+
+    def __reduce__(self) -> tuple:
+        return type(self), (self.args[0], self.estimate, self.up_front)
+
+
+class Cancelled(LindstedtError):
+    """A request stopped at a checkpoint because the cancel event of its ``lindstedt.limits.budget`` block was set."""

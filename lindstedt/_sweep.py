@@ -7,11 +7,20 @@ warning names ``pip install tqdm`` when it is missing) or a callable ``progress(
 called as each task finishes (completion order with an executor).  Used by :func:`lindstedt.nnm_sweep`,
 :func:`lindstedt.validate.backbone`, the fitted orders of :mod:`lindstedt.validate` and the
 forced-response families.
+
+The sweep honours the :mod:`lindstedt.limits` block it runs in: a checkpoint before each task (serial) or as
+each one finishes (executor: the tasks not started are then cancelled), and tasks on a thread pool run in a copy
+of the caller's context, so their own checkpoints see the same budget, cancel event and progress callback
+(a process pool or a Dask cluster does not carry the block to its workers).
 """
 
 from __future__ import annotations
 
+import contextvars
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Callable, Iterable, Sequence, TypeVar
+
+from .limits import checkpoint
 
 __all__ = ["sweep_map"]
 
@@ -65,16 +74,25 @@ def sweep_map(
     try:
         if executor is None:
             for index, value in enumerate(values):
+                checkpoint(description, index, len(values))
                 results[index] = task(value)
                 report(index, value, results[index])
         else:
             from concurrent.futures import as_completed
 
-            futures = {executor.submit(task, value): index for index, value in enumerate(values)}
-            for future in as_completed(futures):
-                index = futures[future]
-                results[index] = future.result()
-                report(index, values[index], results[index])
+            threads = isinstance(executor, ThreadPoolExecutor)
+            futures = {(executor.submit(contextvars.copy_context().run, task, value) if threads
+                        else executor.submit(task, value)): index for index, value in enumerate(values)}
+            try:
+                for done, future in enumerate(as_completed(futures)):
+                    index = futures[future]
+                    results[index] = future.result()
+                    report(index, values[index], results[index])
+                    checkpoint(description, done + 1, len(values))
+            except BaseException:
+                for future in futures:
+                    future.cancel()
+                raise
     finally:
         close()
     return results

@@ -42,6 +42,10 @@ at most ``--max-dof N`` degrees of freedom and ``--max-springs S`` springs (defa
 that many), arrays and objects nested at most 8 deep; beyond them one ``error:`` line names the limit and
 the option, exit status 2.  An output that cannot be written (a full disk) is one line
 ``error: cannot write output: …``, exit status 1.
+Every command takes ``--budget SECONDS`` and ``--budget-memory MB`` (defaults 600 s and 2048 MB; ``none``: no
+limit; see :mod:`lindstedt.limits`): a request whose estimated cost exceeds them is refused before it starts
+(exit status 2, the estimate and what drives it named), and a command that runs past them stops at its next
+checkpoint (exit status 1; a continuation prints the branch computed so far).
 Nothing is written to disk unless asked (``derive --output DIR``, ``demo --figure PATH``, ``forced --figure PATH``).
 """
 
@@ -51,7 +55,8 @@ import argparse
 import sys
 from typing import Any, Sequence
 
-from .._errors import ConvergenceError, LindstedtError, ProblemError
+from .._errors import BudgetError, Cancelled, ConvergenceError, LindstedtError, ProblemError
+from ..limits import budget
 from ._progress import Progress
 from ._signals import INTERRUPTS
 
@@ -157,7 +162,32 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--figure", default=None, metavar="PATH",
                       help="also draw the error of orders 0-2 against the exact flow into PATH (matplotlib; .png, .svg, .pdf...), "
                            "e.g. lindstedt-demo.png (default: write nothing)")
+    for command in commands.choices.values():
+        _add_budget_options(command)
     return parser
+
+
+def _budget_value(text: str) -> float | None:
+    """A budget option's value: a positive number, or ``none`` for no limit."""
+    if text.strip().lower() in ("none", "inf", "infinity"):
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (value > 0 and value != float("inf")):
+        raise argparse.ArgumentTypeError(f"expected a positive number or 'none', got {text!r}")
+    return value
+
+
+def _add_budget_options(command: argparse.ArgumentParser) -> None:
+    from ..limits import DEFAULT
+
+    command.add_argument("--budget", type=_budget_value, default=DEFAULT.seconds, metavar="SECONDS",
+                         help=f"refuse a request estimated above SECONDS of CPU and stop one that runs longer "
+                              f"(default {DEFAULT.seconds:g}; 'none': no limit)")
+    command.add_argument("--budget-memory", type=_budget_value, default=DEFAULT.memory_mb, metavar="MB",
+                         help=f"the same for memory, in MB of growth (default {DEFAULT.memory_mb:g}; 'none': no limit)")
 
 
 def _command_expand(arguments: argparse.Namespace) -> str:
@@ -455,20 +485,8 @@ def _run(argv: Sequence[str] | None) -> int:
         arguments = build_parser().parse_args(argv)
         with INTERRUPTS.deferred():  # mpmath (every command's) imports gmpy2 in a bare `except:` that swallows Ctrl-C
             import mpmath  # noqa: F401
-        if arguments.command == "expand":
-            output = _command_expand(arguments)
-        elif arguments.command == "nnm":
-            output = _command_nnm(arguments)
-        elif arguments.command == "forced":
-            from .forced import run_forced
-
-            output = run_forced(arguments, _parse_parameters(arguments.param))
-        elif arguments.command == "derive":
-            output = _command_derive(arguments)
-        else:
-            from .demo import run_demo
-
-            output = run_demo(order=arguments.order, figure_path=arguments.figure or None)
+        with budget(seconds=arguments.budget, memory_mb=arguments.budget_memory):
+            output = _dispatch(arguments)
         if isinstance(output, tuple):
             output, status = output
         INTERRUPTS.check()  # a Ctrl-C that a library swallowed on the way
@@ -479,12 +497,36 @@ def _run(argv: Sequence[str] | None) -> int:
     except OSError as error:
         where = f" {error.filename!r}" if error.filename else ""
         return _fail(f"cannot access{where}: {error.strerror or error}; check that the path exists and is writable", EXIT_BAD_INPUT)
+    except (BudgetError, Cancelled) as error:  # refused up front: the request is the input to change
+        return _fail(error, EXIT_BAD_INPUT if getattr(error, "up_front", False) else EXIT_FAILED)
     except LindstedtError as error:
         return _fail(error, EXIT_FAILED if isinstance(error, ConvergenceError) else EXIT_BAD_INPUT)
     except RecursionError:
         return _fail("the input is too deeply nested to process; simplify it", EXIT_BAD_INPUT)
     except Exception as error:  # noqa: BLE001 - the command line never shows a traceback
         return _fail(f"internal failure ({type(error).__name__}: {error}); please report it", EXIT_FAILED)
+    return _print_output(output, status)
+
+
+def _dispatch(arguments: argparse.Namespace) -> Any:
+    """The output of the command ``arguments`` name (text, or (text, status))."""
+    if arguments.command == "expand":
+        return _command_expand(arguments)
+    if arguments.command == "nnm":
+        return _command_nnm(arguments)
+    if arguments.command == "forced":
+        from .forced import run_forced
+
+        return run_forced(arguments, _parse_parameters(arguments.param))
+    if arguments.command == "derive":
+        return _command_derive(arguments)
+    from .demo import run_demo
+
+    return run_demo(order=arguments.order, figure_path=arguments.figure or None)
+
+
+def _print_output(output: str, status: int) -> int:
+    """Print the command's output; the exit status (``status``, or 1 when stdout cannot take it)."""
     try:
         print(output)
         sys.stdout.flush()  # a full disk (/dev/full) fails here, not at the interpreter's exit

@@ -11,6 +11,7 @@ from typing import Any, Callable
 from sympy import Rational
 
 from .._precision import locked
+from ..limits import checkpoint
 
 __all__ = ["LazyOrders", "extend_square_root", "shift_powers"]
 
@@ -68,8 +69,12 @@ class LazyOrders:
     _domain: Any
 
     def _ensure(self, order: int) -> None:
+        """Solve the orders up to ``order``; after each one a checkpoint of :mod:`lindstedt.limits` (budget,
+        cancellation, progress), so a stopped request keeps every order it solved."""
         while len(self._squared) <= order:
-            self._solve_order(len(self._squared))  # type: ignore[attr-defined]  # defined by the host class
+            solving = len(self._squared)
+            self._solve_order(solving)  # type: ignore[attr-defined]  # defined by the host class
+            checkpoint("order", solving, order)
 
     @locked
     def squared_frequency(self, order: int) -> Any:

@@ -22,8 +22,11 @@ from ..engine.branches import BranchHierarchy
 from ..engine.contact import contact_normal_form
 from ..engine.smooth import MAX_ORDER, SmoothHierarchy, normal_form
 from ..export.stable import forget_families
+from .._cost import expansion_estimate
+from ..limits import Estimate
 
-__all__ = ["CACHE_MAXSIZE", "CacheInfo", "LindstedtPoincare", "cache_info", "clear_cache", "expand", "validate_order"]
+__all__ = ["CACHE_MAXSIZE", "CacheInfo", "LindstedtPoincare", "cache_info", "clear_cache", "expand", "expansion_cost",
+           "validate_order"]
 
 
 #: Most hierarchies kept by the process-wide cache (least recently used evicted first).
@@ -235,15 +238,31 @@ class LindstedtPoincare:
 
         return _CACHE.get((problem_key, "smooth", digits), build_smooth)
 
+    def estimate(self, problem: Oscillator, order: int) -> Estimate:
+        """What :meth:`expand` of ``problem`` to ``order`` will cost (every ω_k, α_k, v_k up to ``order``): CPU
+        seconds and memory from the cost model of :mod:`lindstedt.limits`, before any work.
+
+        Examples
+        --------
+        >>> from lindstedt.problems.oscillator import Oscillator
+        >>> LindstedtPoincare().estimate(Oscillator("u**3", a0=1, omega0=1), 10).seconds < 1
+        True
+        """
+        validate_order(order)
+        return expansion_estimate(problem, order, self.precision, self.numeric)
+
     def expand(self, problem: Oscillator, order: int):
         """Lindstedt–Poincaré expansion of ``problem`` to ``order``.
+
+        The request is priced first (:meth:`estimate`) and refused with a :class:`~lindstedt.BudgetError`
+        if it exceeds the budget in force (:mod:`lindstedt.limits`).
 
         Returns
         -------
         Expansion
             Lazy, frozen result; nothing beyond the requested quantities is computed.
         """
-        validate_order(order)
+        self.estimate(problem, order).check()
         form, hierarchy = self.hierarchy(problem, order)
         if problem.has_initial_velocity:  # the copy (== problem) that knows how far its release series goes
             problem = self._released(problem, order)
@@ -330,12 +349,51 @@ def expand(
     (0.6, 0.8)
     """
     validate_order(order)
-    if isinstance(f, Oscillator):
-        if (a0 is not None or omega0 is not None or params is not None or normalization != "initial" or a1 != 0
-                or u0 is not None or v0 is not None):
-            raise TypeError("pass either an Oscillator or f with its problem arguments, not both")
-        problem = f
-    else:
-        problem = Oscillator(f, a0=a0, omega0=omega0, params=params, normalization=normalization, a1=a1, u0=u0, v0=v0)
+    problem = _problem(f, a0=a0, omega0=omega0, params=params, normalization=normalization, a1=a1, u0=u0, v0=v0)
     # The hierarchy is taken from the process-wide cache (see lindstedt.clear_cache).
     return LindstedtPoincare(precision=precision, numeric=numeric).expand(problem, order)
+
+
+def _problem(f: Any, **arguments: Any) -> Oscillator:
+    """``f`` if it is an :class:`Oscillator` (then ``arguments`` must be the defaults), else the problem they make."""
+    if isinstance(f, Oscillator):
+        defaults = {"a0": None, "omega0": None, "params": None, "normalization": "initial", "a1": 0, "u0": None,
+                    "v0": None}
+        if any(arguments[name] is not default and arguments[name] != default for name, default in defaults.items()):
+            raise TypeError("pass either an Oscillator or f with its problem arguments, not both")
+        return f
+    return Oscillator(f, **arguments)
+
+
+@locked
+def expansion_cost(
+    f: Any,
+    order: int = 2,
+    *,
+    a0: Any = None,
+    omega0: Any = None,
+    params: Mapping[str, Any] | None = None,
+    normalization: str = "initial",
+    precision: int = 30,
+    numeric: bool = False,
+    a1: Any = 0,
+    u0: Any = None,
+    v0: Any = None,
+) -> Estimate:
+    """What :func:`expand` with the same arguments will cost, before any work: an
+    :class:`~lindstedt.limits.Estimate` (CPU seconds, memory, what drives them, how to make it cheaper).
+
+    ``expand`` refuses a request whose estimate exceeds the budget in force (:mod:`lindstedt.limits`); this
+    prices it without refusing.
+
+    Examples
+    --------
+    >>> import lindstedt
+    >>> cost = lindstedt.expansion_cost("Max(0, u - 1/3)", order=40, a0=1, omega0=1)
+    >>> cost.seconds > lindstedt.limits.DEFAULT.seconds, dict(cost.drivers)["breakpoints"]
+    (True, 1)
+    >>> lindstedt.expansion_cost("Max(0, u - 1/3)", order=40, a0=1, omega0=1, numeric=True).seconds < 60
+    True
+    """
+    problem = _problem(f, a0=a0, omega0=omega0, params=params, normalization=normalization, a1=a1, u0=u0, v0=v0)
+    return LindstedtPoincare(precision=precision, numeric=numeric).estimate(problem, order)

@@ -70,6 +70,7 @@ from typing import Any, Mapping
 import sympy
 
 from .._errors import OrderError, ParameterError, ProblemError, UnsupportedNonlinearityError
+from .._cost import multiple_scales_estimate
 from .._precision import locked, locked_methods
 from ..problems.forced import ForcedOscillator
 from ..problems.oscillator import DISPLACEMENT
@@ -471,6 +472,8 @@ class MultipleScales:
                 f"second-order multiple scales is derived for polynomial f only, not f = {f} (the averaging of the "
                 "product DF1·u1 needs f smooth); use MultipleScales(order=1) for piecewise f"
             )
+        if not polynomial:
+            multiple_scales_estimate(problem).check()
         f1, assumptions = first_harmonic(f)
         second = second_order_averaging(f, omega0, _FORCING) if self.order == 2 else None
         return FrequencyResponseCurve.build(problem, self.order, f1, assumptions, second)

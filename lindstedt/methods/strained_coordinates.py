@@ -25,6 +25,8 @@ from ..engine.modal import modal_guard_digits, modal_normal_form
 from ..problems.nnm import NNMProblem
 from ..problems.system import UnilateralSystem
 from ..results.nnm import NNMExpansion
+from .._cost import nnm_estimate
+from ..limits import Estimate
 
 __all__ = ["StrainedCoordinatesNNM", "nnm", "release_amplitudes_by_series"]
 
@@ -44,12 +46,27 @@ class StrainedCoordinatesNNM:
             raise ProblemError("precision must be an integer number of digits between 15 and 500")
         self.precision = precision
 
-    def expand(self, problem: NNMProblem, order: int = 2) -> NNMExpansion:
-        """The NNM of ``problem`` to ``order`` (ω_0 … ω_order, the a_k, the waveform branches)."""
+    def estimate(self, problem: NNMProblem, order: int = 2) -> Estimate:
+        """What :meth:`expand` will cost (CPU seconds, memory: the cost model of :mod:`lindstedt.limits`).
+
+        Examples
+        --------
+        >>> import lindstedt
+        >>> chain = lindstedt.UnilateralSystem.chain(1000, unilateral=[(0, 0)])
+        >>> cost = StrainedCoordinatesNNM().estimate(lindstedt.NNMProblem(chain, 1, 1), order=2)
+        >>> dict(cost.drivers)["degrees of freedom"], 1 < cost.seconds < 60
+        (1000, True)
+        """
         if not isinstance(problem, NNMProblem):
             raise ProblemError("expand takes an NNMProblem(system, mode, a0, a1=0)")
         if isinstance(order, bool) or not isinstance(order, int) or not 0 <= order <= 12:
             raise ProblemError(f"order must be an integer between 0 and 12, got {order!r}")
+        return nnm_estimate(problem.system, problem.mode, order)
+
+    def expand(self, problem: NNMProblem, order: int = 2) -> NNMExpansion:
+        """The NNM of ``problem`` to ``order`` (ω_0 … ω_order, the a_k, the waveform branches), refused before any
+        work if its :meth:`estimate` exceeds the budget in force (:class:`~lindstedt.BudgetError`)."""
+        self.estimate(problem, order).check()
         system, mode = problem.system, problem.mode
         digits = self.precision + modal_guard_digits(system, mode - 1, order)
         form = modal_normal_form(system, mode - 1, problem.a0, problem.a1, digits)

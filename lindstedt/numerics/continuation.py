@@ -76,7 +76,8 @@ from typing import Any
 
 import numpy as np
 
-from .._errors import ProblemError
+from .._errors import BudgetError, Cancelled, ProblemError
+from ..limits import checkpoint
 from .._sweep import sweep_map
 from ..problems.system import UnilateralSystem
 from .results import ContinuationProgress, NNMBranch, NNMResult, _branch_events
@@ -489,7 +490,12 @@ def _drive(stepper: _Stepper, start: float, stop: float, max_points: int,
         if len(points) >= max_points:
             return finish(points, values, f"max_points = {max_points} reached at {stepper.label} = {values[-1]:.6g}"
                           + stepper.note(), False, rejected, iterations)
-        attempt = stepper.advance(points, values)
+        try:  # a spent budget or a cancel stops the branch where it is: the points so far are kept
+            checkpoint("continuation point", len(points), max_points)
+            attempt = stepper.advance(points, values)
+        except (BudgetError, Cancelled) as stopped:
+            return finish(points, values, f"stopped after {len(points)} point(s): {stopped}", False, rejected,
+                          iterations)
         iterations += attempt.iterations
         rejected += attempt.rejected
         if attempt.end is not None:

@@ -45,7 +45,8 @@ from typing import Any
 
 import numpy as np
 
-from .._errors import LindstedtError, ProblemError
+from .._errors import BudgetError, Cancelled, LindstedtError, ProblemError
+from ..limits import checkpoint
 from ..problems.forced import ForcedOscillator, ForcedSystem, check_forcing_frequency
 from ._period_map import PeriodMap, PeriodMapValue
 from .forced_results import Bifurcation, ForcedOrbit, FrequencyResponse
@@ -161,9 +162,12 @@ def _newton_fixed(count: _Counter, z: np.ndarray, frequency: float, scale: float
     value = None
     try:
         value = count(z, frequency, scale)
+    except (BudgetError, Cancelled):  # the request's budget or cancel: not a failure of this orbit
+        raise
     except LindstedtError as error:
         return False, f"the flow failed at the start: {error}", z, value, 0
     for iteration in range(max_iterations + 1):
+        checkpoint("Newton iteration", iteration, max_iterations)
         r = value.state - z
         norm = float(np.max(np.abs(r)))
         size = max(float(np.max(np.abs(z))), float(np.max(np.abs(value.state))), 1e-300)
@@ -184,6 +188,8 @@ def _newton_fixed(count: _Counter, z: np.ndarray, frequency: float, scale: float
             trial = z + step
             try:
                 trial_value = count(trial, frequency, scale)
+            except (BudgetError, Cancelled):  # the request's budget or cancel: not a failure of this orbit
+                raise
             except LindstedtError as error:
                 if halving == _HALVINGS:
                     return False, f"the flow failed at iteration {iteration}: {error}", z, value, iteration
@@ -283,6 +289,8 @@ def forced_periodic_orbit(flow: PeriodMap | ForcedOscillator | ForcedSystem, fre
             ok, message, z1, value, more = _newton_fixed(count, state, frequency, scale, tol, max_iterations)
             iterations += more
             message = f"{message} (after {transient_periods} periods of transient; from the start: {first})"
+        except (BudgetError, Cancelled):  # the request's budget or cancel: not a failure of this orbit
+            raise
         except LindstedtError as error:
             message = f"{first}; the transient failed: {error}"
     if value is None or value.d_state is None:
@@ -463,80 +471,84 @@ def _drive(cont: _Continuation, w0: np.ndarray, t0: np.ndarray, first: ForcedOrb
     cos_max = math.cos(math.radians(options["max_angle"]))
     half = cont.count.periods // 2
     gap = None
-    while True:
-        if len(points) >= options["max_points"]:
-            message = f"max_points = {options['max_points']} reached at {cont.parameter} = {float(w[-1] * lam_scale):.8g}"
-            break
-        ok, why, w1, value, J = cont.correct(w + h * t, t)
-        if ok:
-            t1 = cont.tangent(J, t)
-            if t1 @ t < cos_max:
-                ok, why = False, f"the tangent turned by more than {options['max_angle']}°"
-        if not ok:
-            rejected += 1
-            h /= 2
-            if h < options["min_step"]:
-                message = (f"step size {h:.2e} below min_step {options['min_step']:.2e} at {cont.parameter} = "
-                           f"{float(w[-1] * lam_scale):.8g}: {why}")
+    try:  # a spent budget or a cancel stops the branch where it is: the points so far are kept
+        while True:
+            checkpoint("continuation point", len(points), options["max_points"])
+            if len(points) >= options["max_points"]:
+                message = f"max_points = {options['max_points']} reached at {cont.parameter} = {float(w[-1] * lam_scale):.8g}"
                 break
-            continue
-        lam = float(w1[-1] * lam_scale)
-        final = stop is not None and (lam - stop) * (stop - float(w0[-1] * lam_scale)) >= 0
-        outside = not (bounds[0] <= lam <= bounds[1])
-        new_tests = cont.tests(value, t1)
-        for kind in _KINDS:
-            f0, f1 = tests[kind], new_tests[kind]
-            if math.isfinite(f0) and math.isfinite(f1) and f0 * f1 < 0 and (kind != "neimark-sacker" or min(abs(f0), abs(f1)) > 1e-9):
-                found = cont.locate(kind, w, t, h, f0, f1, len(points) - 1)
-                if found is not None:
-                    value_at = found.frequency if cont.parameter == "frequency" else found.forcing_scale
-                    if bounds[0] <= value_at <= bounds[1]:
-                        bifurcations.append(found)
-        if final or outside:
-            target = stop if final else (bounds[0] if lam < bounds[0] else bounds[1])
-            lam0 = float(w[-1] * lam_scale)
-            fraction = (target - lam0) / (lam - lam0) if lam != lam0 else 1.0
-            guess = cont.split(w + fraction * (w1 - w))[0]
-            z_value, frequency, scale = cont.split(np.r_[w1[:-1], target / lam_scale])
-            ok, why, z, value, iterations = _newton_fixed(cont.count, guess, frequency, scale, options["tol"],
-                                                          options["max_iterations"])
-            cont.iterations += iterations
+            ok, why, w1, value, J = cont.correct(w + h * t, t)
             if ok:
-                points.append(_orbit(cont.count, z, frequency, scale, value, success=True, message=why,
-                                     iterations=iterations, stability_tol=options["stability_tol"],
-                                     samples=options["samples"], epsilon=getattr(cont.flow, "epsilon", None)))
-                arclength.append(arclength[-1] + h)
-                report(len(points) - 1, points[-1])
-            success = ok  # the branch was followed until it left the range, through stop or (past a fold) start
+                t1 = cont.tangent(J, t)
+                if t1 @ t < cos_max:
+                    ok, why = False, f"the tangent turned by more than {options['max_angle']}°"
             if not ok:
-                message = f"the last point at {cont.parameter} = {target:.8g} failed: {why}"
-            elif final:
-                message = f"reached stop = {target:.8g}"
-            elif rejoin:
-                message = f"reached the end of the range, {cont.parameter} = {target:.8g}"
-            else:
-                message = (f"the branch turned back at a fold and left the range through start, {cont.parameter} = "
-                           f"{target:.8g}; the responses nearer stop = {stop:.8g} lie on another part of the curve: "
-                           f"follow them from {stop:.8g} (or over a wider range)")
-            break
-        points.append(cont.orbit(w1, value, why, 0))
-        arclength.append(arclength[-1] + h)
-        report(len(points) - 1, points[-1])
-        h = _next_step(h, int(why.split()[0]), cont.first_correction, options)
-        w, t, tests = w1, t1, new_tests
-        peak = float(np.max(points[-1].amplitude))
-        if peak > 2 * cont.D[0]:  # the branch grew: rescale so steps stay relative to its size
-            w, t = cont.rescale(w, t, peak)
-        if rejoin:
-            z = cont.split(w)[0]
-            delta = z - cont.count(z, cont.split(w)[1], cont.split(w)[2], sensitivity=False, periods=half).state
-            if gap is not None and delta @ gap < 0 and len(points) > 2:
-                success = True
-                message = (f"the period-{cont.count.periods} branch rejoins the period-{half} branch between "
-                           f"{cont.parameter} = {points[-2].frequency if cont.parameter == 'frequency' else points[-2].forcing_scale:.8g} "
-                           f"and {lam:.8g} (another period doubling)")
+                rejected += 1
+                h /= 2
+                if h < options["min_step"]:
+                    message = (f"step size {h:.2e} below min_step {options['min_step']:.2e} at {cont.parameter} = "
+                               f"{float(w[-1] * lam_scale):.8g}: {why}")
+                    break
+                continue
+            lam = float(w1[-1] * lam_scale)
+            final = stop is not None and (lam - stop) * (stop - float(w0[-1] * lam_scale)) >= 0
+            outside = not (bounds[0] <= lam <= bounds[1])
+            new_tests = cont.tests(value, t1)
+            for kind in _KINDS:
+                f0, f1 = tests[kind], new_tests[kind]
+                if math.isfinite(f0) and math.isfinite(f1) and f0 * f1 < 0 and (kind != "neimark-sacker" or min(abs(f0), abs(f1)) > 1e-9):
+                    found = cont.locate(kind, w, t, h, f0, f1, len(points) - 1)
+                    if found is not None:
+                        value_at = found.frequency if cont.parameter == "frequency" else found.forcing_scale
+                        if bounds[0] <= value_at <= bounds[1]:
+                            bifurcations.append(found)
+            if final or outside:
+                target = stop if final else (bounds[0] if lam < bounds[0] else bounds[1])
+                lam0 = float(w[-1] * lam_scale)
+                fraction = (target - lam0) / (lam - lam0) if lam != lam0 else 1.0
+                guess = cont.split(w + fraction * (w1 - w))[0]
+                z_value, frequency, scale = cont.split(np.r_[w1[:-1], target / lam_scale])
+                ok, why, z, value, iterations = _newton_fixed(cont.count, guess, frequency, scale, options["tol"],
+                                                              options["max_iterations"])
+                cont.iterations += iterations
+                if ok:
+                    points.append(_orbit(cont.count, z, frequency, scale, value, success=True, message=why,
+                                         iterations=iterations, stability_tol=options["stability_tol"],
+                                         samples=options["samples"], epsilon=getattr(cont.flow, "epsilon", None)))
+                    arclength.append(arclength[-1] + h)
+                    report(len(points) - 1, points[-1])
+                success = ok  # the branch was followed until it left the range, through stop or (past a fold) start
+                if not ok:
+                    message = f"the last point at {cont.parameter} = {target:.8g} failed: {why}"
+                elif final:
+                    message = f"reached stop = {target:.8g}"
+                elif rejoin:
+                    message = f"reached the end of the range, {cont.parameter} = {target:.8g}"
+                else:
+                    message = (f"the branch turned back at a fold and left the range through start, {cont.parameter} = "
+                               f"{target:.8g}; the responses nearer stop = {stop:.8g} lie on another part of the curve: "
+                               f"follow them from {stop:.8g} (or over a wider range)")
                 break
-            gap = delta
+            points.append(cont.orbit(w1, value, why, 0))
+            arclength.append(arclength[-1] + h)
+            report(len(points) - 1, points[-1])
+            h = _next_step(h, int(why.split()[0]), cont.first_correction, options)
+            w, t, tests = w1, t1, new_tests
+            peak = float(np.max(points[-1].amplitude))
+            if peak > 2 * cont.D[0]:  # the branch grew: rescale so steps stay relative to its size
+                w, t = cont.rescale(w, t, peak)
+            if rejoin:
+                z = cont.split(w)[0]
+                delta = z - cont.count(z, cont.split(w)[1], cont.split(w)[2], sensitivity=False, periods=half).state
+                if gap is not None and delta @ gap < 0 and len(points) > 2:
+                    success = True
+                    message = (f"the period-{cont.count.periods} branch rejoins the period-{half} branch between "
+                               f"{cont.parameter} = {points[-2].frequency if cont.parameter == 'frequency' else points[-2].forcing_scale:.8g} "
+                               f"and {lam:.8g} (another period doubling)")
+                    break
+                gap = delta
+    except (BudgetError, Cancelled) as stopped:
+        message, success = f"stopped after {len(points)} point(s): {stopped}", False
     return FrequencyResponse(success, (first_message + "; " if first_message else "") + message, cont.parameter,
                              cont.count.periods, getattr(cont.flow, "epsilon", None), _description(cont.flow),
                              tuple(points), np.array(arclength), tuple(bifurcations), cont.iterations + first.newton_iterations,

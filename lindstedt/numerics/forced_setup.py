@@ -24,6 +24,7 @@ from .._errors import LindstedtError, ParameterError, ProblemError
 from .._precision import locked
 from ..problems.forced import ForcedOscillator, ForcedSystem
 from ._period_map import PeriodMap
+from ..limits import Estimate
 
 __all__ = ["MAX_FREQUENCY_RATIO", "MAX_NATURAL_PERIODS", "VERIFY_TOL", "forced_flow"]
 
@@ -38,6 +39,9 @@ MAX_NATURAL_PERIODS = 1000
 #: 0.4 at 1e8; the check of :data:`VERIFY_TOL` reports such orbits as failures); the response there is the
 #: inertia-dominated ``u ≈ −εF cos Ωt/Ω²``
 MAX_FREQUENCY_RATIO = 1e6
+#: A static response ε·|F|/ω_min² (of the forcing alone) above this is refused: the float flows, their events and
+#: Newton's scaling cannot follow a motion of that size (ε or F far outside a weakly nonlinear oscillation)
+MAX_RESPONSE = 1e100
 #: a converged orbit is verified by a second, independent integration of its period (DOP853 at rtol
 #: :data:`_VERIFY_RTOL` with atol scaled to the orbit): the Newton correction that map asks for,
 #: ``(∂Π/∂z − I)⁻¹ (Π₂(z) − z)``, relative to the orbit's displacements D and velocities D·max(Ω, ω), must be ≤ this
@@ -115,7 +119,8 @@ def _linear_frequencies(flow: Any) -> tuple[float, float] | None:
             return None
     except (LindstedtError, np.linalg.LinAlgError, TypeError, ValueError, OverflowError):
         return None
-    roots = [math.sqrt(abs(x)) for x in squares if math.isfinite(x) and x != 0.0]
+    # a square beyond the float range (ω0 ~ 1e300) is an infinite frequency: far above any forcing (refused there)
+    roots = [math.sqrt(abs(x)) if not math.isnan(x) else math.inf for x in squares if x != 0.0 and not math.isnan(x)]
     return (min(roots), max(roots)) if roots else None
 
 
@@ -127,6 +132,7 @@ def _check_cost(flow: Any, frequency: float, periods: int, name: str = "frequenc
     if bounds is None:
         return
     low, high = bounds
+    _check_scales(flow, low)
     natural = periods * max(1.0, high / frequency)
     if natural > MAX_NATURAL_PERIODS:
         raise ParameterError(
@@ -143,6 +149,54 @@ def _check_cost(flow: Any, frequency: float, periods: int, name: str = "frequenc
             f"{MAX_FREQUENCY_RATIO:.0e}, lindstedt.numerics.forced_setup.MAX_FREQUENCY_RATIO): one period is ≈ the "
             f"identity and the periodic orbit is ill-conditioned by ~Ω/ω; the response there is inertia-dominated, "
             f"u ≈ −ε F cos(Ωt)/Ω² (size ~ε F/Ω²); choose Ω ≤ {MAX_FREQUENCY_RATIO * low:.3g}")
+    orbit_estimate(flow, frequency, periods * max(1.0, low / frequency), natural).check()
+
+
+#: CPU seconds of one exact event-driven period map of an N-dof ForcedSystem near resonance: a + b·N²
+#: (measured on chains with two springs, N = 2…100: 0.8 ms, 1.8 ms, 24 ms, 145 ms)
+_EXACT_SYSTEM_MAP = (8e-4, 1.5e-5)
+#: the exact flow of one oscillator: CPU seconds per natural period (≈ 2 switches per breakpoint)
+_EXACT_SECONDS_PER_NATURAL_PERIOD = 2e-4
+
+
+def orbit_estimate(flow: Any, frequency: float, slow_periods: float, natural: float, newton_maps: int = 12) -> Estimate:
+    """The :class:`~lindstedt.limits.Estimate` of one forced periodic orbit: ``newton_maps`` period maps (Newton's
+    iterations and the verification), each spanning ``slow_periods`` periods of the slowest linear mode and
+    ``natural`` of the fastest."""
+    from .forced_smooth import SmoothForcedFlow
+
+    n = getattr(flow, "dimension", 2) // 2
+    if isinstance(flow, SmoothForcedFlow):  # measured for N = 1; the variational equations grow as N²
+        per_map, kind = natural * _SECONDS_PER_NATURAL_PERIOD * n * n, "DOP853 flow"
+    elif n > 1:
+        per_map, kind = (_EXACT_SYSTEM_MAP[0] + _EXACT_SYSTEM_MAP[1] * n * n) * slow_periods, "exact flow"
+    else:
+        per_map, kind = natural * _EXACT_SECONDS_PER_NATURAL_PERIOD, "exact flow"
+    return Estimate(task=f"forced periodic orbit at Ω = {frequency:.6g} ({kind})", seconds=newton_maps * per_map,
+                    memory_mb=max(1.0, 8e-5 * n * n),
+                    drivers=(("degrees of freedom", n), ("natural periods per map", round(natural, 1))),
+                    advice="force nearer the linear frequencies, or reduce the model")
+
+
+def _check_scales(flow: Any, low: float) -> None:
+    """Refuse a problem whose damping or static response lies beyond what the float flows follow (see
+    :data:`MAX_FREQUENCY_RATIO`, :data:`MAX_RESPONSE`), with the reason and the way out."""
+    problem, eps = flow.problem, float(flow.epsilon)
+    if isinstance(problem, ForcedOscillator):
+        omega0, zeta, forcing = problem.numeric_coefficients()
+        if zeta > MAX_FREQUENCY_RATIO:
+            raise ParameterError(f"ζ = {zeta:.3g} is above {MAX_FREQUENCY_RATIO:.0e} "
+                                 "(lindstedt.numerics.forced_setup.MAX_FREQUENCY_RATIO): the damping rate 2ζω0 dwarfs "
+                                 "the natural frequency, the motion is quasi-static (overdamped) and the flow stiff; "
+                                 "give ζ of order one or less")
+        load = abs(forcing)
+    else:
+        load = float(np.max(np.abs(problem.P)))
+    response = abs(eps) * load / (low * low) if low > 0 else math.inf
+    if not response <= MAX_RESPONSE:
+        raise ParameterError(f"the static response to the forcing, ε·|F|/ω² ≈ {response:.1e}, is above "
+                             f"{MAX_RESPONSE:.0e} (lindstedt.numerics.forced_setup.MAX_RESPONSE), beyond what the float "
+                             "flows follow; rescale the problem (units in which ε, F and the response are of order one)")
 
 
 def _verify(flow: Any, z: np.ndarray, frequency: float, scale: float, periods: int,

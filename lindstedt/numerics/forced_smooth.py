@@ -39,6 +39,7 @@ import numpy as np
 import sympy
 
 from .._errors import ConvergenceError, ProblemError, UnsupportedNonlinearityError
+from ..limits import checkpoint
 from .forced_setup import _real as _real_number
 from .._precision import locked
 from ..problems.forced import ForcedOscillator, ForcedSystem, check_forcing_frequency
@@ -48,6 +49,12 @@ __all__ = ["SmoothForcedFlow"]
 
 #: switches at one instant (no time advancing) before the run is declared stuck on a breakpoint (sliding)
 _MAX_INSTANT_SWITCHES = 50
+#: right-hand-side evaluations allowed per natural period the run spans (a regular period takes ~35 DOP853 steps,
+#: ~420 evaluations): beyond, the motion is stiff or diverging (e.g. a steep law driven past its breakpoint) and the
+#: run fails instead of creeping on
+_MAX_EVALUATIONS_PER_NATURAL_PERIOD = 100_000
+#: evaluations between two checkpoints of lindstedt.limits (budget, cancellation) inside one integration
+_CHECKPOINT_EVERY = 5_000
 _SWITCHING = (sympy.Max, sympy.Min, sympy.Abs, sympy.Heaviside, sympy.sign, sympy.Piecewise)
 #: math-module stand-ins for functions lambdify's math printer does not know
 _MODULES = [{"Heaviside": lambda x, h=0.5: 1.0 if x > 0 else (0.0 if x < 0 else h),
@@ -135,6 +142,28 @@ class _ScalarLaw:
         return index
 
 
+class _Metered:
+    """Counts the right-hand-side evaluations of one run: a checkpoint of :mod:`lindstedt.limits` every
+    :data:`_CHECKPOINT_EVERY`, a :class:`ConvergenceError` past ``limit`` (a stiff or diverging motion)."""
+
+    def __init__(self, limit: int) -> None:
+        self.count, self.limit = 0, limit
+
+    def wrap(self, field: Callable[[float, np.ndarray], np.ndarray]) -> Callable[[float, np.ndarray], np.ndarray]:
+        def metered(time: float, y: np.ndarray) -> np.ndarray:
+            self.count += 1
+            if self.count % _CHECKPOINT_EVERY == 0:
+                checkpoint("DOP853 evaluation", self.count)
+                if self.count > self.limit:
+                    raise ConvergenceError(
+                        f"DOP853 needed more than {self.limit} evaluations at t = {time:.6g} "
+                        f"({_MAX_EVALUATIONS_PER_NATURAL_PERIOD} per natural period spanned): the motion is stiff or "
+                        "diverging (e.g. a steep law driven far past its breakpoint)")
+            return field(time, y)
+
+        return metered
+
+
 def _real(function: Callable[[float], Any], fallback: Callable[[float], Any] | None) -> Callable[[float], float]:
     """``function`` as a real-valued float function; outside its interval (a fractional power of a negative
     distance, met by a Runge–Kutta stage beyond the breakpoint) the whole law (or 0 for a derivative)."""
@@ -144,6 +173,9 @@ def _real(function: Callable[[float], Any], fallback: Callable[[float], Any] | N
             value = function(u)
         except (ValueError, ZeroDivisionError):
             value = complex("nan")
+        except OverflowError:  # the state left the float range: the flow fails (a failed orbit, not a crash)
+            raise ConvergenceError(f"f(u) overflows a float at u = {u:.3g}: the motion diverges (or the problem needs "
+                                   "rescaling)") from None
         if isinstance(value, complex) or not math.isfinite(value):
             return float(fallback(u)) if fallback is not None else 0.0
         return float(value)
@@ -375,8 +407,10 @@ class SmoothForcedFlow:
         stalled = 0
         samples: list[np.ndarray] = []
         atol = self._absolute_tolerances(z, frequency, scale, sensitivity)
+        natural = int(periods) * max(1.0, self._frequencies[1] / frequency)
+        evaluations = _Metered(int(_MAX_EVALUATIONS_PER_NATURAL_PERIOD * natural))
         while True:
-            rhs = self._fields(region, frequency, scale, sensitivity)
+            rhs = evaluations.wrap(self._fields(region, frequency, scale, sensitivity))
             events = self._events(region)
             y0 = np.concatenate((z, Y.reshape(-1))) if sensitivity else z
             window = None if times is None else times[(times >= t) & (times < end)]

@@ -91,6 +91,7 @@ import numpy as np
 
 from .._errors import ConvergenceError, ProblemError
 from .._precision import LOCK
+from ..limits import checkpoint
 from .flow import ExactFlow
 from ..problems.parsing import parse_float
 from ..problems.system import UnilateralSystem
@@ -710,6 +711,7 @@ def _newton(
     norm = float(np.max(np.abs(current["residual"])))
     sizes: list[float] = []
     for iteration in range(1, max_iterations + 1):
+        checkpoint("Newton iteration", iteration, max_iterations)
         step, ratio = _scaled_solve(current[jacobian_key], -current["residual"], columns)
         if norm <= tol:
             # converged: the Newton step already computed polishes the last digits (quadratic convergence), as a

@@ -585,7 +585,17 @@ def parse_real(value: Any, *, what: str) -> sympy.Expr:
         approximation = complex(sympy.N(number, 30))
         if number.is_real is False or approximation.imag != 0 or not math.isfinite(approximation.real):
             raise ProblemError(f"{what} = {value!r} is not a real number; give a finite real number")
+    if number != 0:
+        size = abs(number) if number.is_Rational else abs(sympy.N(number, 15))
+        if not _SMALLEST_MAGNITUDE <= size <= _LARGEST_MAGNITUDE:
+            raise ProblemError(f"{what} = {value!r} is beyond the range of a float (magnitudes 1e-300 to 1e300), where "
+                               "the numerics and the float evaluators cannot follow; rescale the problem (choose units "
+                               "in which it is of order one)")
     return number
+
+
+#: The magnitudes a number of a problem may have (beyond them no float evaluator, flow or export can hold it).
+_SMALLEST_MAGNITUDE, _LARGEST_MAGNITUDE = sympy.Rational(1, 10**300), sympy.Integer(10**300)
 
 
 def parse_value(value: Any, *, name: str, symbol: sympy.Symbol) -> sympy.Expr:

@@ -709,19 +709,28 @@ class Expansion:
             ))
         return tuple(result)
 
+    def _solve_through(self, highest: int) -> int:
+        """Solve the hierarchy through order ``highest`` in one pass (so that its checkpoints report progress
+        against the whole request, see :mod:`lindstedt.limits`); returns ``highest``."""
+        self._hierarchy.squared_frequency(highest)
+        return highest
+
     @cached_property
     def omega(self) -> tuple[sympy.Expr, ...]:
         """(ω_0, …, ω_N), exact."""
+        self._solve_through(self._steps * self.order)
         return tuple(self.omega_correction(k) for k in range(self._steps * self.order + 1))
 
     @cached_property
     def alpha(self) -> tuple[sympy.Expr, ...]:
         """(α_0, …, α_N) with ω² = Σ α_k ε^k, exact."""
+        self._solve_through(self._steps * self.order)
         return tuple(self.alpha_correction(k) for k in range(self._steps * self.order + 1))
 
     @cached_property
     def waveforms(self) -> tuple[Waveform | PiecewiseWaveform, ...]:
         """(v_0, …, v_N), exact cosine polynomials."""
+        self._solve_through(self._steps * self.order)
         return tuple(self.waveform(k) for k in range(self._steps * self.order + 1))
 
     @cached_property

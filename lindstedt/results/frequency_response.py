@@ -441,6 +441,10 @@ class FrequencyResponseCurve(JsonExport):
             self._cache[key] = sympy.Poly(sympy.expand(numerator), AMPLITUDE)
         polynomial = self._cache[key]
         coefficients = [complex(sympy.N(c.subs({DETUNING: sigma, EPSILON: eps}), 30)).real for c in polynomial.all_coeffs()]
+        if not all(math.isfinite(c) for c in coefficients):
+            raise ParameterError(f"the steady-state amplitude equation at detuning σ = {sigma:.6g}, ε = {eps:.6g} has "
+                                 "coefficients beyond the range of a float (a forcing, damping or ε far too large); "
+                                 "rescale the problem")
         while coefficients and coefficients[0] == 0:
             coefficients.pop(0)
         roots = np.roots(coefficients) if len(coefficients) > 1 else np.array([])

@@ -1,0 +1,242 @@
+"""The cost model of an expansion: CPU seconds and memory of ``expand(f, N)`` from what the request holds.
+
+An expansion to order N costs ``T = exp(θ · x)`` CPU seconds, where x are the request's features — the order
+(``log(N + 1)``), the polynomial degree of f, its breakpoints B (``log B``), the symbolic parameters, the
+working digits P (``log(P/30)``), a release with velocity, and products of these where the measurements
+show the exponent of N to depend on them — and θ holds one fitted vector per kind of request:
+
+* ``polynomial`` — f a polynomial in u, exact rational (or symbolic) arithmetic;
+* ``analytic`` — f analytic but not polynomial (``sin(u)``), cosine series at P digits;
+* ``piecewise`` — f piecewise polynomial, exact algebraic numbers (contact angles arccos κ);
+* ``piecewise-float`` — the same at P digits (``numeric=True`` or floats in the input);
+* ``contact-law`` — a non-polynomial contact law (Hertz), its contact arc solved in stretched time at P digits.
+
+Memory is ``growth = c · T^γ · B^δ`` MB over the process (one fit over every kind, B ≥ 1 the breakpoints).  The constants come
+from ``benchmarks/bench_cost_model.py --fit``, which measures a calibration set of requests on the
+benchmark machine (the ratio measured/estimated stays within :data:`lindstedt.limits.FACTOR` there).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import sympy
+
+from .limits import Estimate
+
+__all__ = ["ExpansionFeatures", "expansion_estimate", "expansion_features", "multiple_scales_estimate", "nnm_estimate"]
+
+_SWITCHES = (sympy.Max, sympy.Min, sympy.Heaviside, sympy.Abs, sympy.sign)
+
+#: The features each kind's model uses (the measurements show no dependence on the others).
+FEATURES_OF_KIND: dict[str, tuple[str, ...]] = {
+    "polynomial": ("1", "n", "n2", "degree", "degree_n", "symbols", "symbols_n", "scale", "scale_n", "velocity"),
+    "analytic": ("1", "n", "n2", "p", "p_n", "p2"),
+    "piecewise": ("1", "n", "n2", "b", "b_n", "b2", "symbols", "symbols_n", "scale", "scale_n", "degree", "dn", "dn2",
+                  "origin", "origin_n", "velocity"),
+    "piecewise-float": ("1", "n", "b", "p", "p_n"),
+    "contact-law": ("1", "n", "p", "p_n"),
+}
+#: θ per kind: {feature: coefficient} over :data:`FEATURES_OF_KIND` (fitted, see the module docstring).
+_THETA: dict[str, dict[str, float]] = {
+    "polynomial": {"1": -4.3557, "n": -2.0943, "n2": 0.4454, "degree": -1.8738, "degree_n": 1.2758,
+                  "symbols": 0.2188, "symbols_n": 0.8055, "scale": 1.697, "scale_n": -0.2968, "velocity": 1.9633},
+    "analytic": {"1": -4.2079, "n": -0.625, "n2": 0.6578, "p": 0.3069, "p_n": -0.189, "p2": 0.4335},
+    "piecewise": {"1": -5.6341, "n": -0.8401, "n2": 0.7298, "b": -1.1651, "b_n": 1.7309, "b2": 0.4449,
+                 "symbols": 1.8307, "symbols_n": 0.1568, "scale": -0.1788, "scale_n": 2.3971, "degree": -0.8953,
+                 "dn": 0.7678, "dn2": 0.2514, "origin": 0.406, "origin_n": -0.692, "velocity": 0.3394},
+    "piecewise-float": {"1": -7.9002, "n": 2.1297, "b": 0.7962, "p": 0.414, "p_n": -0.1985},
+    "contact-law": {"1": -2.7263, "n": 0.9698, "p": 1.8098, "p_n": -0.0362},
+}
+#: The fewest digits a method works at (LindstedtPoincare's precision ≥ 15).
+_LEAST_DIGITS = 15
+#: memory growth (MB) = _MEMORY[0] · T^_MEMORY[1] · B^_MEMORY[2] (B the breakpoints, at least 1), never below 1 MB
+_MEMORY = (9.339, 0.674, 0.512)
+
+
+@dataclass(frozen=True)
+class ExpansionFeatures:
+    """What an expansion request holds that its cost depends on."""
+
+    kind: str
+    order: int
+    degree: int
+    breakpoints: int
+    symbols: int
+    symbolic_scale: bool
+    digits: int
+    initial_velocity: bool
+    origin: bool = False
+
+    @property
+    def coefficients(self) -> int:
+        """The highest order solved (grazing, whose gauge √ε doubles the indices, measured no dearer: not priced)."""
+        return self.order
+
+    def vector(self, coefficients: int | None = None, digits: int | None = None,
+               breakpoints: int | None = None) -> dict[str, float]:
+        """The features x of the model ``log T = θ · x`` (at other coefficients, digits or breakpoints if given)."""
+        n = math.log((self.coefficients if coefficients is None else coefficients) + 1)
+        b = math.log(max(self.breakpoints if breakpoints is None else breakpoints, 1))
+        p = math.log((self.digits if digits is None else digits) / 30)
+        degree = math.log(max(self.degree, 1))
+        dn = math.log(max(self.degree, 1) * (self.coefficients if coefficients is None else coefficients) + 1)
+        scale = float(self.symbolic_scale)
+        return {
+            "1": 1.0, "n": n, "n2": n * n, "degree": degree, "degree_n": degree * n, "dn": dn, "dn2": dn * dn,
+            "origin": float(self.origin), "origin_n": float(self.origin) * n, "b": b, "b_n": b * n, "b2": b * b,
+            "symbols": float(self.symbols), "symbols_n": self.symbols * n, "scale": scale, "scale_n": scale * n,
+            "p": p, "p_n": p * n, "p2": p * p, "velocity": float(self.initial_velocity),
+        }
+
+    def log_seconds(self) -> float:
+        """log T: the fitted model made monotone — the most it gives over every lower order (from 1), fewer digits
+        (down to the least a method takes) and fewer breakpoints, so that asking for more never prices less."""
+        theta = _THETA[self.kind]
+        best = -math.inf
+        for coefficients in range(min(1, self.coefficients), self.coefficients + 1):  # order 0 alone: no fit below 1
+            for digits in {_LEAST_DIGITS, self.digits}:
+                for breakpoints in {1, self.breakpoints}:
+                    vector = self.vector(coefficients, min(digits, self.digits), breakpoints)
+                    best = max(best, sum(value * vector[name] for name, value in theta.items()))
+        return best
+
+    def drivers(self) -> tuple[tuple[str, Any], ...]:
+        """The features as they are named in messages."""
+        items: list[tuple[str, Any]] = [("kind", self.kind), ("order", self.order)]
+        if self.breakpoints:
+            items.append(("breakpoints", self.breakpoints))
+        if self.degree > 1:
+            items.append(("degree", self.degree))
+        if self.symbols:
+            items.append(("symbolic parameters", self.symbols))
+        if self.symbolic_scale:
+            items.append(("symbolic a0/omega0", True))
+        if self.kind in ("analytic", "piecewise-float", "contact-law"):
+            items.append(("digits", self.digits))
+        if self.initial_velocity:
+            items.append(("initial velocity", True))
+        if self.origin:
+            items.append(("breakpoints at 0", True))
+        return tuple(items)
+
+
+def _degree(f: sympy.Expr, variable: sympy.Symbol) -> int:
+    """The polynomial degree of f in u, reading every switch as linear (``Max(0, u)**2`` has degree 2)."""
+    linear = f.replace(lambda e: isinstance(e, _SWITCHES + (sympy.Piecewise,)), lambda e: variable)
+    try:
+        return max(1, int(sympy.Poly(linear, variable).degree()))
+    except (sympy.PolynomialError, sympy.GeneratorsNeeded, ValueError):
+        powers = [int(p.exp) for p in f.atoms(sympy.Pow) if p.base.has(variable) and p.exp.is_Integer and p.exp > 0]
+        return max([1, *powers])
+
+
+def _at_origin(f: sympy.Expr, variable: sympy.Symbol) -> bool:
+    """True when every switch of f turns at u = 0 (contact angle π/2: rational cosines, the cheapest algebra)."""
+    arguments = [argument for atom in f.atoms(*_SWITCHES) for argument in atom.args if argument.has(variable)]
+    return bool(arguments) and not f.atoms(sympy.Piecewise) and all(argument.subs(variable, 0) == 0 for argument in arguments)
+
+
+def _breakpoints(f: sympy.Expr, variable: sympy.Symbol) -> int:
+    """How many breakpoints f has: one per switch of u (``Max(0, u - b)``, ``Heaviside(u)``, ...), and the
+    conditions of a Piecewise."""
+    switches = sum(1 for atom in f.atoms(*_SWITCHES) if atom.has(variable))
+    return switches + sum(max(len(piecewise.args) - 1, 1) for piecewise in f.atoms(sympy.Piecewise))
+
+
+def expansion_features(problem: Any, order: int, precision: int, numeric: bool) -> ExpansionFeatures:
+    """The :class:`ExpansionFeatures` of ``LindstedtPoincare(precision, numeric).expand(problem, order)``."""
+    from .problems.oscillator import DISPLACEMENT
+    from .problems.piecewise_linear import has_non_polynomial_law
+
+    f = problem.nonlinearity
+    breakpoints = _breakpoints(f, DISPLACEMENT) if problem.is_non_smooth else 0
+    if problem.is_non_smooth:
+        if has_non_polynomial_law(f, DISPLACEMENT):
+            kind = "contact-law"
+        else:
+            floats = numeric or any(isinstance(atom, sympy.Float) for atom in f.atoms(sympy.Number))
+            kind = "piecewise-float" if floats else "piecewise"
+    else:
+        kind = "polynomial" if problem.is_polynomial else "analytic"
+    exact_kind = kind in ("polynomial", "piecewise")
+    return ExpansionFeatures(
+        kind=kind,
+        order=order,
+        degree=_degree(f, DISPLACEMENT),
+        breakpoints=breakpoints,
+        symbols=len(problem.symbolic_parameters),
+        symbolic_scale=not (problem.a0.is_number and problem.omega0.is_number),
+        digits=30 if exact_kind else precision,
+        initial_velocity=problem.has_initial_velocity,
+        origin=problem.is_non_smooth and _at_origin(f, DISPLACEMENT),
+    )
+
+
+def expansion_estimate(problem: Any, order: int, precision: int, numeric: bool) -> Estimate:
+    """The :class:`~lindstedt.limits.Estimate` of an expansion request (see the module docstring)."""
+    features = expansion_features(problem, order, precision, numeric)
+    seconds = math.exp(min(features.log_seconds(), 700.0))
+    scale, power, per_breakpoint = _MEMORY
+    memory = max(1.0, scale * seconds**power * max(features.breakpoints, 1) ** per_breakpoint)
+    advice = _advice(problem, features, precision)
+    law = str(problem.f)
+    law = law if len(law) <= 60 else law[:57] + "..."
+    vector = features.vector()
+    return Estimate(task=f"expansion of {law} to order {order}", seconds=seconds, memory_mb=memory,
+                    drivers=features.drivers(), advice=advice,
+                    features=tuple((name, vector[name]) for name in FEATURES_OF_KIND[features.kind]))
+
+
+def _advice(problem: Any, features: ExpansionFeatures, precision: int) -> str:
+    if features.kind == "piecewise":
+        return "numeric=True computes the same coefficients in floats of `precision` digits, much faster; or ask for a lower order"
+    if features.kind in ("analytic", "piecewise-float", "contact-law"):
+        return "ask for fewer digits (precision) or a lower order"
+    if features.symbols or features.symbolic_scale:
+        return "give the symbolic parameters (and a0, omega0) numbers, or ask for a lower order"
+    return "ask for a lower order"
+
+
+#: The NNM expansion of an N-dof system with S springs: T = exp(θ0) · N^θ1 · S^θ2 · (order + 1)^θ3 CPU seconds
+#: (fitted on chains, ``benchmarks/bench_cost_model.py``; the working digits, 30 to 300, measured no dearer).
+_NNM = (-13.176, 1.475, 1.084, 3.985)
+#: Its memory: the modal matrices (``_NNM_MEMORY[0] · N²`` MB) or the hierarchy (``_NNM_MEMORY[1] · T^0.9`` MB).
+_NNM_MEMORY = (3.5e-4, 12.0)
+
+
+def nnm_estimate(system: Any, mode: int, order: int) -> Estimate:
+    """The :class:`~lindstedt.limits.Estimate` of the strained-coordinates NNM of ``system`` to ``order``."""
+    n, springs = system.n_dof, max(len(system.b), 1)
+    constant, per_dof, per_spring, per_order = _NNM
+    seconds = math.exp(constant) * n**per_dof * springs**per_spring * (order + 1) ** per_order
+    memory = max(1.0, _NNM_MEMORY[0] * n * n, _NNM_MEMORY[1] * seconds**0.9)
+    return Estimate(task=f"NNM expansion of mode {mode} of a {n}-dof system to order {order}", seconds=seconds,
+                    memory_mb=memory, drivers=(("degrees of freedom", n), ("springs", springs), ("order", order)),
+                    advice="ask for a lower order, or reduce the model (fewer degrees of freedom)")
+
+
+#: First-order multiple scales of a piecewise-polynomial f: the closed form f1(A) per regime costs
+#: ``_MULTIPLE_SCALES[0] · d^_MULTIPLE_SCALES[1] · B`` CPU seconds (d the degree, B ≥ 1 the breakpoints; measured on
+#: ``Max(0, u - 1/5)**d``, d = 2…64: sympy's simplification of each regime's coefficient dominates).
+_MULTIPLE_SCALES = (1.9e-3, 2.1)
+
+
+def multiple_scales_estimate(problem: Any) -> Estimate:
+    """The :class:`~lindstedt.limits.Estimate` of the multiple-scales response curve of a forced oscillator."""
+    from .problems.oscillator import DISPLACEMENT
+
+    f = problem.nonlinearity
+    degree = _degree(f, DISPLACEMENT)
+    breakpoints = max(_breakpoints(f, DISPLACEMENT), 1)
+    seconds = _MULTIPLE_SCALES[0] * degree ** _MULTIPLE_SCALES[1] * breakpoints
+    return Estimate(task=f"multiple-scales response of {_short(f)}", seconds=seconds, memory_mb=max(1.0, 10 * seconds),
+                    drivers=(("degree", degree), ("breakpoints", breakpoints)),
+                    advice="a law of lower degree, or the exact flow (method 'exact')")
+
+
+def _short(expression: Any) -> str:
+    text = str(expression)
+    return text if len(text) <= 60 else text[:57] + "..."
