@@ -38,6 +38,7 @@ REGISTRY: dict[str, tuple[str, str]] = {
     "method-pairs": ("bench_method_pairs", "run"),
     "codegen-stability": ("bench_codegen_stability", "run"),
     "contact-laws": ("bench_contact_laws", "run"),
+    "cost-model": ("bench_cost_model", "run"),
     "performance": ("bench_performance", "run"),
     "forced": ("bench_forced", "run"),
 }

@@ -11,7 +11,8 @@ show the exponent of N to depend on them — and θ holds one fitted vector per 
 * ``piecewise-float`` — the same at P digits (``numeric=True`` or floats in the input);
 * ``contact-law`` — a non-polynomial contact law (Hertz), its contact arc solved in stretched time at P digits.
 
-Memory is ``growth = c · T^γ · B^δ`` MB over the process (one fit over every kind, B ≥ 1 the breakpoints).  The constants come
+Memory is ``growth = c · T^γ · B^δ · (P/30)^η`` MB over the process (one fit over every kind, B ≥ 1 the
+breakpoints, P the digits).  The constants come
 from ``benchmarks/bench_cost_model.py --fit``, which measures a calibration set of requests on the
 benchmark machine (the ratio measured/estimated stays within :data:`lindstedt.limits.FACTOR` there).
 """
@@ -41,19 +42,20 @@ FEATURES_OF_KIND: dict[str, tuple[str, ...]] = {
 }
 #: θ per kind: {feature: coefficient} over :data:`FEATURES_OF_KIND` (fitted, see the module docstring).
 _THETA: dict[str, dict[str, float]] = {
-    "polynomial": {"1": -4.3557, "n": -2.0943, "n2": 0.4454, "degree": -1.8738, "degree_n": 1.2758,
-                  "symbols": 0.2188, "symbols_n": 0.8055, "scale": 1.697, "scale_n": -0.2968, "velocity": 1.9633},
-    "analytic": {"1": -4.2079, "n": -0.625, "n2": 0.6578, "p": 0.3069, "p_n": -0.189, "p2": 0.4335},
-    "piecewise": {"1": -5.6341, "n": -0.8401, "n2": 0.7298, "b": -1.1651, "b_n": 1.7309, "b2": 0.4449,
-                 "symbols": 1.8307, "symbols_n": 0.1568, "scale": -0.1788, "scale_n": 2.3971, "degree": -0.8953,
-                 "dn": 0.7678, "dn2": 0.2514, "origin": 0.406, "origin_n": -0.692, "velocity": 0.3394},
-    "piecewise-float": {"1": -7.9002, "n": 2.1297, "b": 0.7962, "p": 0.414, "p_n": -0.1985},
-    "contact-law": {"1": -2.7263, "n": 0.9698, "p": 1.8098, "p_n": -0.0362},
+    "polynomial": {"1": -3.0151, "n": -2.7361, "n2": 0.5072, "degree": -2.3599, "degree_n": 1.4444,
+                  "symbols": 0.2257, "symbols_n": 0.7629, "scale": 1.4507, "scale_n": -0.2183, "velocity": 1.9369},
+    "analytic": {"1": -3.5351, "n": -0.9345, "n2": 0.6741, "p": -0.6122, "p_n": 0.0629, "p2": 0.6052},
+    "piecewise": {"1": -5.5305, "n": -0.6708, "n2": 0.7062, "b": -1.1632, "b_n": 1.6953, "b2": 0.4526,
+                 "symbols": 1.1137, "symbols_n": 0.6166, "scale": -1.5165, "scale_n": 3.4173, "degree": -0.8743,
+                 "dn": 0.5223, "dn2": 0.2934, "origin": 0.4123, "origin_n": -0.7645, "velocity": 0.2298},
+    "piecewise-float": {"1": -7.8879, "n": 2.1409, "b": 0.7186, "p": 0.3286, "p_n": -0.1632},
+    "contact-law": {"1": -2.7991, "n": 0.9765, "p": 1.8169, "p_n": -0.0145},
 }
 #: The fewest digits a method works at (LindstedtPoincare's precision ≥ 15).
 _LEAST_DIGITS = 15
-#: memory growth (MB) = _MEMORY[0] · T^_MEMORY[1] · B^_MEMORY[2] (B the breakpoints, at least 1), never below 1 MB
-_MEMORY = (9.339, 0.674, 0.512)
+#: memory growth (MB) = _MEMORY[0] · T^_MEMORY[1] · B^_MEMORY[2] · (P/30)^_MEMORY[3] (B ≥ 1 the breakpoints, P the
+#: digits), never below 1 MB
+_MEMORY = (9.265, 0.682, 0.526, 0.071)
 
 
 @dataclass(frozen=True)
@@ -179,8 +181,9 @@ def expansion_estimate(problem: Any, order: int, precision: int, numeric: bool) 
     """The :class:`~lindstedt.limits.Estimate` of an expansion request (see the module docstring)."""
     features = expansion_features(problem, order, precision, numeric)
     seconds = math.exp(min(features.log_seconds(), 700.0))
-    scale, power, per_breakpoint = _MEMORY
-    memory = max(1.0, scale * seconds**power * max(features.breakpoints, 1) ** per_breakpoint)
+    scale, power, per_breakpoint, per_digit = _MEMORY
+    memory = max(1.0, scale * seconds**power * max(features.breakpoints, 1) ** per_breakpoint
+                 * (features.digits / 30) ** per_digit)
     advice = _advice(problem, features, precision)
     law = str(problem.f)
     law = law if len(law) <= 60 else law[:57] + "..."
@@ -204,7 +207,7 @@ def _advice(problem: Any, features: ExpansionFeatures, precision: int) -> str:
 #: (fitted on chains, ``benchmarks/bench_cost_model.py``; the working digits, 30 to 300, measured no dearer).
 _NNM = (-13.176, 1.475, 1.084, 3.985)
 #: Its memory: the modal matrices (``_NNM_MEMORY[0] · N²`` MB) or the hierarchy (``_NNM_MEMORY[1] · T^0.9`` MB).
-_NNM_MEMORY = (3.5e-4, 12.0)
+_NNM_MEMORY = (9.265, 0.682, 0.526, 0.071)
 
 
 def nnm_estimate(system: Any, mode: int, order: int) -> Estimate:

@@ -341,7 +341,7 @@ def test_the_api_reference_has_an_entry_for_every_public_name(site):
     import lindstedt
 
     anchors = _pages(site)[(site / "api.html").resolve()].anchors
-    for module_name in ("lindstedt", "lindstedt.plot", "lindstedt.references", "lindstedt.validate",
+    for module_name in ("lindstedt", "lindstedt.limits", "lindstedt.plot", "lindstedt.references", "lindstedt.validate",
                         "lindstedt.numerics", "lindstedt.algebra"):
         module = importlib.import_module(module_name)
         names = getattr(module, "__all__", None) or [name for name in vars(module) if not name.startswith("_")]

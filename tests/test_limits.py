@@ -208,3 +208,11 @@ def test_the_command_line_refuses_with_one_line_naming_the_option(capsys):
     for bad in ("0", "-3", "nan", "soon"):
         assert main(["expand", "u**3", "--budget", bad]) == 2
         assert "--budget" in capsys.readouterr().err
+
+
+def test_progress_true_draws_a_bar_per_stage(capfd):
+    pytest.importorskip("tqdm", reason="progress=True draws tqdm bars")
+    with limits.budget(progress=True):
+        omega = lindstedt.expand("u**3 + u**5", order=6, **ONE).omega
+    assert len(omega) == 7
+    assert "order" in capfd.readouterr().err

@@ -28,7 +28,7 @@ PUBLIC_MODULES = (
     "lindstedt.references",
     "lindstedt.validate",
 )
-SUBPACKAGES = ("lindstedt.algebra", "lindstedt.numerics", "lindstedt.references", "lindstedt.validate")
+SUBPACKAGES = ("lindstedt.algebra", "lindstedt.limits", "lindstedt.numerics", "lindstedt.references", "lindstedt.validate")
 
 #: the dotted path of a private module: lindstedt, dots, then a name with one leading underscore (dunders are public)
 PRIVATE_PATH = re.compile(r"\blindstedt(?:\.\w+)*\._(?!_)\w*")

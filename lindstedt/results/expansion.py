@@ -1604,9 +1604,9 @@ class Expansion:
         """
         if quantity in ("displacement", "velocity"):
             expression = self.displacement_expr(derivative=quantity == "velocity")
-            return sympy.lambdify((TIME, EPSILON, *self.arguments), expression, modules=modules)
+            return _lambdify((TIME, EPSILON, *self.arguments), expression, modules)
         if quantity == "frequency":
-            return sympy.lambdify((EPSILON, *self.arguments), self.frequency_expr(), modules=modules)
+            return _lambdify((EPSILON, *self.arguments), self.frequency_expr(), modules)
         raise ProblemError(f"quantity must be 'displacement', 'velocity' or 'frequency', got {quantity!r}")
 
     def to_latex(self, *, waveforms: bool = False) -> str:
@@ -1747,3 +1747,16 @@ class Expansion:
             lines += [f"  A_{k} = {value}" for k, value in enumerate(self.amplitude)]
             lines += [f"  phi_{k} = {value}" for k, value in enumerate(self.phase)]
         return "\n".join(lines)
+
+
+def _lambdify(arguments: tuple, expression: sympy.Expr, modules: Any) -> Callable[..., Any]:
+    """``sympy.lambdify``; for NumPy with its printer's default settings except the order of terms, which the
+    default printer sorts by evaluating every term numerically (8× the time for closed forms in arccos of an
+    irrational contact point: 7.8 s → 1.0 s for ``Max(0, u - acos(1/3)/2)`` at order 2, measured)."""
+    if modules != "numpy":
+        return sympy.lambdify(arguments, expression, modules=modules)
+    from sympy.printing.numpy import NumPyPrinter
+
+    printer = NumPyPrinter({"fully_qualified_modules": False, "inline": True, "allow_unknown_functions": True,
+                            "user_functions": {}, "order": "none"})
+    return sympy.lambdify(arguments, expression, modules=modules, printer=printer)
