@@ -95,7 +95,7 @@ def _random_requests(count: int, seed: int = 23) -> list[dict[str, Any]]:
     return requests
 
 
-def measure(specs: list[dict[str, Any]], timeout: float = 180.0) -> list[dict[str, Any]]:
+def measure(specs: list[dict[str, Any]], timeout: float = 400.0) -> list[dict[str, Any]]:
     rows = []
     for spec in specs:
         outcome = run_worker(sys.executable, WORKERS_DIR / "lindstedt_cost.py", [json.dumps(spec)], timeout)

@@ -95,7 +95,8 @@ class Estimate:
     """What a request is expected to cost before it runs: CPU ``seconds`` and ``memory_mb`` of growth, the
     ``drivers`` they come from (``(name, value)`` pairs: order, breakpoints, digits, ...), and ``advice`` on making
     the request cheaper; ``features`` are the model's inputs x of ``log T = θ · x`` (what a benchmark refits θ on).
-    The model holds within :data:`FACTOR` on the benchmark machine.
+    The model holds within :data:`FACTOR` on the benchmark machine; ``least`` marks an estimate of the least the
+    request can cost (a search whose length is not known before it runs: its checkpoints watch the rest).
 
     Examples
     --------
@@ -115,6 +116,7 @@ class Estimate:
     drivers: tuple[tuple[str, Any], ...] = ()
     advice: str = ""
     features: tuple[tuple[str, float], ...] = field(default=(), repr=False)
+    least: bool = False
 
     def __str__(self) -> str:
         drivers = ", ".join(f"{name} {value}" if value is not True else name for name, value in self.drivers)
@@ -133,7 +135,8 @@ class Estimate:
         if over is None:
             return self
         advice = f"{self.advice}; or r" if self.advice else "R"
-        raise BudgetError(f"{self} estimated (within a factor {FACTOR:g}), above {over[0]}: {advice}aise the budget "
+        how = "at the least" if self.least else f"estimated (within a factor {FACTOR:g})"
+        raise BudgetError(f"{self} {how}, above {over[0]}: {advice}aise the budget "
                           f"with lindstedt.limits.budget({over[1]}", estimate=self, up_front=True)
 
 

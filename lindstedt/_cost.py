@@ -27,7 +27,8 @@ import sympy
 
 from .limits import Estimate
 
-__all__ = ["ExpansionFeatures", "expansion_estimate", "expansion_features", "multiple_scales_estimate", "nnm_estimate"]
+__all__ = ["ExpansionFeatures", "expansion_estimate", "expansion_features", "multiple_scales_estimate", "nnm_estimate",
+           "shooting_estimate"]
 
 _SWITCHES = (sympy.Max, sympy.Min, sympy.Heaviside, sympy.Abs, sympy.sign)
 
@@ -207,7 +208,7 @@ def _advice(problem: Any, features: ExpansionFeatures, precision: int) -> str:
 #: (fitted on chains, ``benchmarks/bench_cost_model.py``; the working digits, 30 to 300, measured no dearer).
 _NNM = (-13.176, 1.475, 1.084, 3.985)
 #: Its memory: the modal matrices (``_NNM_MEMORY[0] · N²`` MB) or the hierarchy (``_NNM_MEMORY[1] · T^0.9`` MB).
-_NNM_MEMORY = (9.265, 0.682, 0.526, 0.071)
+_NNM_MEMORY = (3.5e-4, 12.0)
 
 
 def nnm_estimate(system: Any, mode: int, order: int) -> Estimate:
@@ -223,8 +224,9 @@ def nnm_estimate(system: Any, mode: int, order: int) -> Estimate:
 
 #: First-order multiple scales of a piecewise-polynomial f: the closed form f1(A) per regime costs
 #: ``_MULTIPLE_SCALES[0] · d^_MULTIPLE_SCALES[1] · B`` CPU seconds (d the degree, B ≥ 1 the breakpoints; measured on
-#: ``Max(0, u - 1/5)**d``, d = 2…64: sympy's simplification of each regime's coefficient dominates).
-_MULTIPLE_SCALES = (1.9e-3, 2.1)
+#: ``Max(0, u - 1/5)**d``, d = 2…64: sympy's simplification of each regime's coefficient dominates); its memory
+#: ``_MULTIPLE_SCALES[2] · T^_MULTIPLE_SCALES[3]`` MB (10 MB at d = 32, 30 MB at d = 64).
+_MULTIPLE_SCALES = (1.9e-3, 2.1, 5.0, 0.7)
 
 
 def multiple_scales_estimate(problem: Any) -> Estimate:
@@ -235,7 +237,8 @@ def multiple_scales_estimate(problem: Any) -> Estimate:
     degree = _degree(f, DISPLACEMENT)
     breakpoints = max(_breakpoints(f, DISPLACEMENT), 1)
     seconds = _MULTIPLE_SCALES[0] * degree ** _MULTIPLE_SCALES[1] * breakpoints
-    return Estimate(task=f"multiple-scales response of {_short(f)}", seconds=seconds, memory_mb=max(1.0, 10 * seconds),
+    return Estimate(task=f"multiple-scales response of {_short(f)}", seconds=seconds,
+                    memory_mb=max(1.0, _MULTIPLE_SCALES[2] * seconds ** _MULTIPLE_SCALES[3]),
                     drivers=(("degree", degree), ("breakpoints", breakpoints)),
                     advice="a law of lower degree, or the exact flow (method 'exact')")
 
@@ -243,3 +246,19 @@ def multiple_scales_estimate(problem: Any) -> Estimate:
 def _short(expression: Any) -> str:
     text = str(expression)
     return text if len(text) <= 60 else text[:57] + "..."
+
+
+#: One exact event-driven flow over a period of an N-dof UnilateralSystem: ``_SHOOTING_FLOW · N²`` CPU seconds
+#: (measured by nnm_point on chains with two springs: 3 ms at N = 10, 3.6 ms at N = 20, 66 ms at N = 40).
+_SHOOTING_FLOW = 4.1e-5
+
+
+def shooting_estimate(system: Any, flows: int, task: str) -> Estimate:
+    """The least a shooting request costs: ``flows`` exact flows over a period of ``system`` (the Newton
+    iterations of one point, or the first point of a continuation; more points cost more, watched by the budget's
+    checkpoints)."""
+    n = system.n_dof
+    seconds = flows * _SHOOTING_FLOW * n * n
+    return Estimate(task=task, seconds=seconds, memory_mb=max(1.0, 8e-6 * n * n * (len(system.b) + 2)),
+                    drivers=(("degrees of freedom", n), ("flows at least", flows)),
+                    advice="reduce the model (fewer degrees of freedom)", least=True)

@@ -216,3 +216,28 @@ def test_progress_true_draws_a_bar_per_stage(capfd):
         omega = lindstedt.expand("u**3 + u**5", order=6, **ONE).omega
     assert len(omega) == 7
     assert "order" in capfd.readouterr().err
+
+
+def test_nnm_expansions_shooting_and_multiple_scales_are_priced_before_the_work():
+    chain = lindstedt.UnilateralSystem.chain(200, unilateral=[(0, 0.0)])
+    with limits.budget(seconds=0.5):
+        with pytest.raises(lindstedt.BudgetError, match="NNM expansion .* 200-dof .* order 12"):
+            lindstedt.nnm(chain, mode=1, a0=1, order=12)
+        with pytest.raises(lindstedt.BudgetError, match="at the least, above the time budget") as refused:
+            lindstedt.nnm_point(chain, 0.5, 1, modal_amplitude=1.0)
+        assert refused.value.estimate.least and refused.value.up_front
+        with pytest.raises(lindstedt.BudgetError, match="NNM continuation"):
+            lindstedt.continue_nnm(chain, 1, modal_amplitude=1.0, start=0.0, stop=0.5)
+        steep = lindstedt.ForcedOscillator("Max(0, u - 1/5)**200", omega0=1, zeta="1/50")
+        with pytest.raises(lindstedt.BudgetError, match=r"multiple-scales response .*\(degree 200"):
+            lindstedt.frequency_response_curve(steep)
+    assert lindstedt.nnm(chain, mode=1, a0=1, order=1).omega[0] > 0  # the same system, priced within the budget
+
+
+def test_a_forced_orbit_is_priced_from_the_periods_its_maps_span():
+    problem = lindstedt.ForcedOscillator("u**3", omega0=1, zeta="1/50")
+    with limits.budget(seconds=0.01):  # one DOP853 map over ~700 natural periods: seconds of Newton
+        with pytest.raises(lindstedt.BudgetError, match=r"forced periodic orbit at Ω = 0.0015 \(DOP853 flow\)"):
+            lindstedt.forced_periodic_orbit(problem, 0.0015, epsilon=0.1)
+    with limits.budget(seconds=60):
+        assert lindstedt.forced_periodic_orbit(problem, 1.2, epsilon=0.1).success

@@ -77,6 +77,7 @@ from typing import Any
 import numpy as np
 
 from .._errors import BudgetError, Cancelled, ProblemError
+from .._cost import shooting_estimate
 from ..limits import checkpoint
 from .._sweep import sweep_map
 from ..problems.system import UnilateralSystem
@@ -406,6 +407,7 @@ def continue_nnm(
     if method == "seed" and (parameter != "epsilon" or path.amplitude.kind == "modal_amplitude"):
         raise ProblemError("method='seed' is the seed's algorithm: parameter='epsilon' with energy= or "
                            "energy_per_epsilon=")
+    shooting_estimate(system, max_iterations + 1, f"NNM continuation of mode {mode} (its first point)").check()
     options = dict(tol=tol, verify_tol=verify_tol, stability_tol=stability_tol, max_iterations=max_iterations)
     stepper = _METHODS[method](problem, path, start, stop, step=step, min_step=min_step, max_step=max_step,
                                max_halvings=max_halvings, options=options)

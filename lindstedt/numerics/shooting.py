@@ -91,6 +91,7 @@ import numpy as np
 
 from .._errors import ConvergenceError, ProblemError
 from .._precision import LOCK
+from .._cost import shooting_estimate
 from ..limits import checkpoint
 from .flow import ExactFlow
 from ..problems.parsing import parse_float
@@ -944,6 +945,7 @@ def nnm_point(
     problem = NNMShooting(system, mode, energy=energy, modal_amplitude=modal_amplitude,
                           energy_per_epsilon=energy_per_epsilon, formulation=formulation, release_sign=release_sign)
     epsilon = _check_epsilon(epsilon)
+    shooting_estimate(system, max_iterations + 1, f"NNM point of mode {mode} (shooting)").check()
     impossible = _impossible_amplitude(problem, epsilon, problem.amplitude)
     if impossible:
         return problem._failure(epsilon, impossible)
