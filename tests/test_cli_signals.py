@@ -142,6 +142,9 @@ def test_summaries_of_nnm_shooting_and_high_orders_and_silence_below(capsys):
     assert re.fullmatch(r"expand: orders 0-10, \d+\.\d s\n", capsys.readouterr().err)
     assert main(["expand", "u**3", "--order", "9", "--format", "json"]) == 0
     assert capsys.readouterr().err == ""  # short commands print their result only
+    # a low order priced above a second (a gap with symbolic a0 and omega0: ~2 s) reports too
+    assert main(["expand", "Max(0, u - 1/3)", "--order", "4", "--format", "json"]) == 0
+    assert re.fullmatch(r"expand: orders 0-4, \d+\.\d s\n", capsys.readouterr().err)
     assert main(["forced", "u**3", "--eps", "0.1", "--zeta", "0.05", "--at", "1.05"]) == 0
     assert capsys.readouterr().err == ""
 

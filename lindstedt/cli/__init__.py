@@ -32,9 +32,9 @@ unexpected internal error).  JSON output never contains NaN or infinities: a
 failed numerical result has ``null`` values with ``"success": false`` and a message.
 A validity warning of an evaluated expansion (``--eps``), like any other warning, is one line ``warning: …``
 on stderr.  Ctrl-C stops any command with the one line ``error: interrupted`` and exit status 130.
-Long commands (``forced`` sweeps, ``nnm --numeric``, ``expand`` from order 10) show their progress on
-stderr while they run when it is a terminal (a tqdm bar, if tqdm is installed), and otherwise print one
-summary line there when they succeed (e.g. ``forced: 214 points, 2 folds, 3.1 s``); stdout holds the
+Long commands (``forced`` sweeps, ``nnm --numeric``, ``expand`` from order 10 or estimated at a second or more)
+show their progress on stderr while they run when it is a terminal (a tqdm bar, if tqdm is installed), and
+otherwise print one summary line there when they succeed (e.g. ``forced: 214 points, 2 folds, 3.1 s``); stdout holds the
 result alone.
 System files (``nnm SYSTEM.json``, ``forced FORCED.json``) are read within limits checked before the work:
 at most ``--max-dof N`` degrees of freedom and ``--max-springs S`` springs (default 100 each), at most
@@ -66,8 +66,9 @@ EXIT_BAD_INPUT = 2
 EXIT_FAILED = 1
 #: Ctrl-C (SIGINT): the shell's convention, 128 + 2
 EXIT_INTERRUPTED = 130
-#: ``expand`` from this order on shows its progress (orders one by one)
-HIGH_ORDER = 10
+#: ``expand`` from this order on, or estimated to take this many seconds (lindstedt.expansion_cost), shows its
+#: progress (orders one by one)
+HIGH_ORDER, PROGRESS_SECONDS = 10, 1.0
 
 FORMATS = ("pretty", "plain", "text", "latex", "json")
 FORMAT_HELP = (
@@ -191,7 +192,7 @@ def _add_budget_options(command: argparse.ArgumentParser) -> None:
 
 
 def _command_expand(arguments: argparse.Namespace) -> str:
-    if arguments.order < HIGH_ORDER:
+    if arguments.order < HIGH_ORDER and _expand_cost(arguments).seconds < PROGRESS_SECONDS:
         return _expand_output(arguments)
     with Progress("expand", total=arguments.order + 2, unit="step") as progress:
         text = _expand_output(arguments, progress)
@@ -199,21 +200,22 @@ def _command_expand(arguments: argparse.Namespace) -> str:
     return text
 
 
+def _expand_arguments(arguments: argparse.Namespace) -> dict[str, Any]:
+    return dict(order=arguments.order, a0=arguments.a0, omega0=arguments.omega0,
+                params=_parse_parameters(arguments.param), normalization=arguments.normalization,
+                precision=arguments.precision, a1=arguments.a1, u0=arguments.u0, v0=arguments.v0)
+
+
+def _expand_cost(arguments: argparse.Namespace) -> Any:
+    from ..methods.lindstedt_poincare import expansion_cost
+
+    return expansion_cost(arguments.f, **_expand_arguments(arguments))
+
+
 def _expand_output(arguments: argparse.Namespace, progress: Progress | None = None) -> str:
     from ..methods.lindstedt_poincare import expand
 
-    expansion = expand(
-        arguments.f,
-        order=arguments.order,
-        a0=arguments.a0,
-        omega0=arguments.omega0,
-        params=_parse_parameters(arguments.param),
-        normalization=arguments.normalization,
-        precision=arguments.precision,
-        a1=arguments.a1,
-        u0=arguments.u0,
-        v0=arguments.v0,
-    )
+    expansion = expand(arguments.f, **_expand_arguments(arguments))
     if progress is not None:  # the orders one by one (the hierarchy is lazy), then the output
         for k in range(arguments.order + 1):
             progress.update(status=f"order {k}")
