@@ -196,6 +196,7 @@ BEYOND_FLOAT_RANGE = {
     "forced-ms-forcing-1e300": ["forced", "u**3", *MULTIPLE_SCALES, "--forcing", "1e300"],
     "expand --u0=1e400": ["expand", "u**3", "--omega0", "1", "--u0", "1e400", "--v0", "1"],
     "expand --v0=1e400": ["expand", "u**3", "--omega0", "1", "--u0", "1", "--v0", "1e400"],
+    "expand --u0=1e200": ["expand", "u**3", "--omega0", "1", "--u0", "1e200", "--v0", "1"],  # its square is not
     "nnm --a0=1e400": ["nnm", "{system}", "--mode", "1", "--a0", "1e400", "--format", "plain"],
     "expand-f-Max(0,u-1/5)**200-budget": ["expand", "Max(0, u - 1/5)**200", *EXPAND, "--budget", "10"],
     "forced-ms-f-Max(0,u-1/5)**200-budget": ["forced", "Max(0, u - 1/5)**200", *MULTIPLE_SCALES, "--budget", "10"],

@@ -42,6 +42,7 @@ import copy
 import difflib
 import keyword
 import math
+import sys
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
@@ -64,6 +65,10 @@ RESERVED_NAMES = frozenset({"u", "s", "t", "w", "epsilon", "a0", "omega0"}) | fr
 #: an engine by default (``release_shifts``); :class:`~lindstedt.LindstedtPoincare` extends it to the
 #: order it expands to (:meth:`Oscillator.with_release_order`).
 DEFAULT_RELEASE_ORDER = 4
+
+
+#: the largest (u0·ω0)² + v0² taken: a finite float (sympy extracts the square root of it through a float)
+_LARGEST_SQUARE = sympy.Rational(*sys.float_info.max.as_integer_ratio())
 
 
 def _default_amplitude() -> sympy.Symbol:
@@ -464,7 +469,11 @@ class Oscillator:
             raise ProblemError("u0 = v0 = 0 is the rest state, which does not move: give a nonzero u0 or v0")
         if speed == 0:
             return start, None, None  # the release at rest at a0 = u0: the same problem as Oscillator(f, a0=u0)
-        amplitude = sympy.sqrt(start**2 * omega0**2 + speed**2) / omega0
+        radicand = start**2 * omega0**2 + speed**2
+        if radicand.is_number and radicand > _LARGEST_SQUARE:  # sympy's root extraction passes it through a float
+            raise ProblemError(f"u0 = {self.u0!r}, v0 = {self.v0!r}: the squared turning point (u0·ω0)² + v0² is beyond the range "
+                               "of a float; rescale the problem (choose units in which the motion is of order one)")
+        amplitude = sympy.sqrt(radicand) / omega0
         if amplitude.is_positive is not True:  # pragma: no cover - omega0 > 0 and v0 != 0
             raise ProblemError(f"the turning point A0 = {amplitude} is not known to be positive; give omega0 as a number")
         return amplitude, start, speed

@@ -36,6 +36,7 @@ import ast
 import math
 import numbers
 import re
+import sys
 from dataclasses import dataclass
 from decimal import Decimal
 from fractions import Fraction
@@ -588,14 +589,16 @@ def parse_real(value: Any, *, what: str) -> sympy.Expr:
     if number != 0:
         size = abs(number) if number.is_Rational else abs(sympy.N(number, 15))
         if not _SMALLEST_MAGNITUDE <= size <= _LARGEST_MAGNITUDE:
-            raise ProblemError(f"{what} = {value!r} is beyond the range of a float (magnitudes 1e-300 to 1e300), where "
+            raise ProblemError(f"{what} = {value!r} is beyond the range of a float (magnitudes 5e-324 to 1.8e308), where "
                                "the numerics and the float evaluators cannot follow; rescale the problem (choose units "
                                "in which it is of order one)")
     return number
 
 
-#: The magnitudes a number of a problem may have (beyond them no float evaluator, flow or export can hold it).
-_SMALLEST_MAGNITUDE, _LARGEST_MAGNITUDE = sympy.Rational(1, 10**300), sympy.Integer(10**300)
+#: The magnitudes a number of a problem may have: those of a finite float, from the smallest subnormal to the
+#: largest (beyond them no float evaluator, flow or export can hold it)
+_SMALLEST_MAGNITUDE = sympy.Rational(1, 2**1074)
+_LARGEST_MAGNITUDE = sympy.Rational(*sys.float_info.max.as_integer_ratio())
 
 
 def parse_value(value: Any, *, name: str, symbol: sympy.Symbol) -> sympy.Expr:
