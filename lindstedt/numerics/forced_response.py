@@ -549,12 +549,40 @@ def _drive(cont: _Continuation, w0: np.ndarray, t0: np.ndarray, first: ForcedOrb
                 gap = delta
     except (BudgetError, Cancelled) as stopped:
         message, success = f"stopped after {len(points)} point(s): {stopped}", False
+    if success:
+        disagreement = _verify_branch(cont, points)
+        if disagreement:
+            success, message = False, f"{disagreement}; {message}"
     return FrequencyResponse(success, (first_message + "; " if first_message else "") + message, cont.parameter,
                              cont.count.periods, getattr(cont.flow, "epsilon", None), _description(cont.flow),
                              tuple(points), np.array(arclength), tuple(bifurcations), cont.iterations + first.newton_iterations,
                              cont.count.maps + first.flow_evaluations, cont.count.steps + first.steps,
                              cont.count.evaluations + first.evaluations, rejected, time.perf_counter() - started,
                              cont.flow, (cont.parameter, cont.fixed, cont.D, bounds))
+
+
+#: a branch reported a success has this many of its points (evenly spread, the last included) checked by an
+#: independent DOP853 period (forced_setup._verify; its first point was checked by forced_periodic_orbit)
+_VERIFIED_POINTS = 6
+
+
+def _verify_branch(cont: _Continuation, points: list[ForcedOrbit]) -> str:
+    """'' if the sampled points of the branch agree with an independent integration, else what disagreed."""
+    if len(points) < 2:
+        return ""
+    picked = sorted({round(k * (len(points) - 1) / (_VERIFIED_POINTS - 1)) for k in range(1, _VERIFIED_POINTS)})
+    try:
+        for index in picked:
+            orbit = points[index]
+            if orbit.monodromy is None:
+                continue
+            ok, note = _verify(cont.flow, orbit.state, orbit.frequency, orbit.forcing_scale, cont.count.periods,
+                               orbit.monodromy)
+            if not ok:
+                return f"point {index} (Ω = {orbit.frequency:.8g}) fails the independent check: {note}"
+    except (BudgetError, Cancelled) as stopped:
+        return f"the branch was not verified independently: {stopped}"
+    return ""
 
 
 def _scales(flow: PeriodMap, orbit: ForcedOrbit, frequency: float, span: float, amplitude_scale: float | None) -> np.ndarray:
