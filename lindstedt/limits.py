@@ -43,30 +43,7 @@ Traceback (most recent call last):
 lindstedt._errors.BudgetError: expansion of Max(0, u - 1/3) to order 30: ~... estimated (within a factor 4), above the time budget of 10 s: ...
 """
 
-from ._budget import (
-    DEFAULT,
-    FACTOR,
-    Budget,
-    BudgetError,
-    Cancelled,
-    Estimate,
-    Progress,
-    budget,
-    checkpoint,
-    current,
-    set_default,
-)
+from . import _budget
+from ._budget import *  # noqa: F403 - exactly the names of _budget.__all__
 
-__all__ = [
-    "DEFAULT",
-    "FACTOR",
-    "Budget",
-    "BudgetError",
-    "Cancelled",
-    "Estimate",
-    "Progress",
-    "budget",
-    "checkpoint",
-    "current",
-    "set_default",
-]
+__all__ = list(_budget.__all__)

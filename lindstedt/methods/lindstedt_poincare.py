@@ -355,36 +355,26 @@ def expand(
 
 
 def _problem(f: Any, **arguments: Any) -> Oscillator:
-    """``f`` if it is an :class:`Oscillator` (then ``arguments`` must be the defaults), else the problem they make."""
+    """``f`` if it is an :class:`Oscillator` (then ``arguments`` must be the defaults), else the problem they make
+    (``arguments``: those of :class:`Oscillator`, a0, omega0, params, normalization, a1, u0, v0)."""
     if isinstance(f, Oscillator):
         defaults = {"a0": None, "omega0": None, "params": None, "normalization": "initial", "a1": 0, "u0": None,
                     "v0": None}
-        if any(arguments[name] is not default and arguments[name] != default for name, default in defaults.items()):
+        if any(arguments.get(name, default) is not default and arguments.get(name, default) != default
+               for name, default in defaults.items()):
             raise TypeError("pass either an Oscillator or f with its problem arguments, not both")
         return f
     return Oscillator(f, **arguments)
 
 
 @locked
-def expansion_cost(
-    f: Any,
-    order: int = 2,
-    *,
-    a0: Any = None,
-    omega0: Any = None,
-    params: Mapping[str, Any] | None = None,
-    normalization: str = "initial",
-    precision: int = 30,
-    numeric: bool = False,
-    a1: Any = 0,
-    u0: Any = None,
-    v0: Any = None,
-) -> Estimate:
+def expansion_cost(f: Any, order: int = 2, *, precision: int = 30, numeric: bool = False, **problem: Any) -> Estimate:
     """What :func:`expand` with the same arguments will cost, before any work: an
     :class:`~lindstedt.limits.Estimate` (CPU seconds, memory, what drives them, how to make it cheaper).
 
     ``expand`` refuses a request whose estimate exceeds the budget in force (:mod:`lindstedt.limits`); this
-    prices it without refusing.
+    prices it without refusing.  ``problem`` holds expand's problem arguments (a0, omega0, params,
+    normalization, a1, u0, v0).
 
     Examples
     --------
@@ -395,5 +385,4 @@ def expansion_cost(
     >>> lindstedt.expansion_cost("Max(0, u - 1/3)", order=40, a0=1, omega0=1, numeric=True).seconds < 60
     True
     """
-    problem = _problem(f, a0=a0, omega0=omega0, params=params, normalization=normalization, a1=a1, u0=u0, v0=v0)
-    return LindstedtPoincare(precision=precision, numeric=numeric).estimate(problem, order)
+    return LindstedtPoincare(precision=precision, numeric=numeric).estimate(_problem(f, **problem), order)
