@@ -141,44 +141,62 @@ def fit(rows: list[dict[str, Any]]) -> tuple[dict[str, dict[str, float]], tuple[
     return theta, tuple(round(float(value), 3) for value in (math.exp(intercept), power, breakpoints, digits))
 
 
-def _ratio_table(rows: list[dict[str, Any]]) -> tuple[str, float, float]:
+def _options(kw: dict[str, Any]) -> str:
+    text = [f"{k}={v}" for k, v in kw.items() if k not in ("a0", "omega0") or v != 1]
+    if "a0" not in kw and "u0" not in kw:
+        text.insert(0, "symbolic a0, omega0")
+    return ", ".join(text)
+
+
+def _ratio_table(rows: list[dict[str, Any]]) -> tuple[str, tuple[float, float], tuple[float, float]]:
+    """The markdown table and the ranges of measured/estimated time and memory (above the noise: 0.05 s, 5 MB)."""
     lines = ["| f | order | options | measured s | estimated s | ratio | memory MB | estimated MB |", "|---|---|---|---|---|---|---|---|"]
-    ratios = []
+    ratios, memory = [], []
     for row in rows:
         spec = row["spec"]
-        options = ", ".join(f"{k}={v}" for k, v in spec["kw"].items() if k not in ("a0", "omega0") or v != 1)
+        options = _options(spec["kw"])
         if row.get("seconds") is None:
             lines.append(f"| `{spec['f']}` | {spec['order']} | {options} | {row['status']} | | | | |")
             continue
         ratio = row["seconds"] / row["estimate_seconds"]
         if row["seconds"] > 0.05 or row["estimate_seconds"] > 0.05:  # below that, process noise
             ratios.append(ratio)
+        if row["memory_mb"] > 5:
+            memory.append(row["memory_mb"] / row["estimate_memory_mb"])
         lines.append(f"| `{spec['f']}` | {spec['order']} | {options} | {row['seconds']:.3g} | {row['estimate_seconds']:.3g} | "
                      f"{ratio:.2f} | {row['memory_mb']:.0f} | {row['estimate_memory_mb']:.0f} |")
-    return "\n".join(lines), min(ratios), max(ratios)
+    return "\n".join(lines), (min(ratios), max(ratios)), (min(memory), max(memory))
 
 
 def run(quick: bool = False) -> str:
     load = load_average()
     calibration = measure(CALIBRATION[::3] if quick else CALIBRATION)
     sample = measure(_random_requests(8 if quick else 30))
-    write_json("cost_model.json", {"calibration": calibration, "random": sample, "load": load})
-    table, low, high = _ratio_table(calibration)
-    random_table, random_low, random_high = _ratio_table(sample)
+    data = {"calibration": calibration, "random": sample, "load": load}
+    write_json("cost_model.json", data)
+    return section(data)
+
+
+def section(data: dict[str, Any]) -> str:
+    """The README section of a run's data (``results/cost_model.json``)."""
+    table, (low, high), (memory_low, memory_high) = _ratio_table(data["calibration"])
+    random_table, (random_low, random_high), (random_memory_low, random_memory_high) = _ratio_table(data["random"])
     return "\n".join([
         "## Cost model of `expand`: estimate vs measurement",
         "",
         "Each request runs in a fresh process after a warm-up expansion of another problem; measured is the CPU time",
         "(`time.process_time`) and the growth of the resident set of deriving every ω_k, α_k and v_k up to the order,",
         "next to `lindstedt.expansion_cost` of the same request (the estimate `expand` checks against the budget).",
-        f"Load average at start: {load}.",
+        f"Load average at start: {data['load']}.",
         "",
-        f"Calibration set (the constants of `lindstedt/_cost.py` are fitted on it): measured / estimated in "
-        f"[{low:.2f}, {high:.2f}] over the requests above 0.05 s.",
+        f"Calibration set (the constants of `lindstedt/_cost.py` are fitted on it): measured / estimated time in "
+        f"[{low:.2f}, {high:.2f}] over the requests above 0.05 s, memory in [{memory_low:.2f}, {memory_high:.2f}] "
+        "over those above 5 MB.",
         "",
         table,
         "",
-        f"Seeded random requests (not fitted on): measured / estimated in [{random_low:.2f}, {random_high:.2f}].",
+        f"Seeded random requests (not fitted on): measured / estimated time in [{random_low:.2f}, {random_high:.2f}], "
+        f"memory in [{random_memory_low:.2f}, {random_memory_high:.2f}].",
         "",
         random_table,
         "",
