@@ -82,11 +82,11 @@ from .forced_response import (
     switch_period_doubling,
 )
 from .smooth import smooth_flow
-from .continuation import continue_nnm, nnm_sweep
+from .continuation import continue_nnm, nnm_point, nnm_sweep
 from .examples import seed_example_system
 from .results import ContinuationProgress, NNMBranch, NNMResult, to_dataframe
 from .sensitivity import flow_epsilon_derivative
-from .shooting import NNMShooting, nnm_energy, nnm_point
+from .shooting import NNMShooting, nnm_energy
 
 __all__ = [
     "ExactFlow",

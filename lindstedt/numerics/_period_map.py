@@ -13,12 +13,16 @@ bifurcation code only talk to this interface.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
-from typing import Any, Protocol, runtime_checkable
+from typing import Any, Protocol, Sequence, runtime_checkable
 
 import numpy as np
 
-__all__ = ["PeriodMap", "PeriodMapValue"]
+from .._errors import LindstedtError, ParameterError, ProblemError
+from ..problems.forced import ForcedOscillator, ForcedSystem
+
+__all__ = ["PeriodMap", "PeriodMapValue", "linear_frequency_bounds", "real_argument"]
 
 
 @dataclass(frozen=True)
@@ -68,3 +72,55 @@ class PeriodMap(Protocol):
         Used for amplitudes, harmonics and spectra of a periodic response.
         """
         ...
+
+
+def linear_frequency_bounds(problem: Any, epsilon: float, slopes: Sequence[float] = ()) -> tuple[float, float] | None:
+    """(lowest, highest) frequency of the linear pieces of a forced problem, ``ω² = eig(M⁻¹(K + ε·slope))``: for an
+    oscillator ``ω0² + ε·slope`` over 0 and its law's ``slopes``, for a system K and K + ε W A; None when they cannot
+    be formed (symbols left, a singular M).  A square beyond the float range is an infinite frequency.
+
+    Every flow of the package reports its own (``linear_frequencies()``): the cost checks and step sizes use them.
+
+    Examples
+    --------
+    >>> from lindstedt import ForcedOscillator
+    >>> linear_frequency_bounds(ForcedOscillator("Max(0, u - 1/5)", omega0=1, zeta="1/50"), 3.0, [1.0])
+    (1.0, 2.0)
+    """
+    try:
+        if isinstance(problem, ForcedOscillator):
+            omega0 = problem.numeric_coefficients()[0]
+            squares = [omega0 * omega0 + epsilon * slope for slope in (0.0, *slopes)]
+        elif isinstance(problem, ForcedSystem):
+            s = problem.system
+            A = np.array(s.A, dtype=float).reshape(-1, s.n_dof)
+            W = np.array(s.W, dtype=float).reshape(s.n_dof, -1)
+            stiffnesses = [s.K] + ([s.K + epsilon * W @ A] if A.size else [])
+            squares = [float(x) for K in stiffnesses for x in np.linalg.eigvals(np.linalg.solve(s.M, K)).real]
+        else:
+            return None
+    except (LindstedtError, np.linalg.LinAlgError, TypeError, ValueError, OverflowError):
+        return None
+    roots = [math.sqrt(abs(x)) for x in squares if x != 0.0 and not math.isnan(x)]
+    return (min(roots), max(roots)) if roots else None
+
+
+def real_argument(value: Any, name: str) -> float:
+    """A finite real number (a float, an int or a numeric string through the one parser), or a
+    :class:`ParameterError` naming the form (the one reading of ε, load scales and ranges of the forced numerics).
+
+    Examples
+    --------
+    >>> real_argument("1/4", "epsilon")
+    0.25
+    """
+    from ..problems.parsing import parse_float
+
+    if isinstance(value, (np.floating, np.integer)):
+        value = value.item()
+    try:
+        return parse_float(value, what=name)
+    except ParameterError:
+        raise
+    except ProblemError as error:
+        raise ParameterError(str(error)) from None

@@ -89,12 +89,12 @@ from .shooting import (
     _Amplitude,
     _ExpansionPredictor,
     _impossible_amplitude,
+    _guess_unknowns,
     _newton,
     nnm_energy,
-    nnm_point,
 )
 
-__all__ = ["continue_nnm", "nnm_sweep"]
+__all__ = ["continue_nnm", "nnm_point", "nnm_sweep"]
 
 _PARAMETERS = ("epsilon", "energy", "modal_amplitude")
 
@@ -1127,3 +1127,103 @@ def nnm_sweep(
     values = [float(v) for v in values]
     task = partial(_sweep_task, system=system, mode=mode, parameter=parameter, epsilon=epsilon, options=options)
     return sweep_map(task, values, executor=executor, progress=progress, description="nnm_sweep")
+
+
+def nnm_point(
+    system: UnilateralSystem,
+    epsilon: float,
+    mode: int,
+    *,
+    energy: float | None = None,
+    modal_amplitude: float | None = None,
+    energy_per_epsilon: float | None = None,
+    formulation: str = "symmetric",
+    initial_guess: Any = None,
+    release_sign: int = 1,
+    tol: float = 1e-11,
+    verify_tol: float = 1e-8,
+    stability_tol: float = 1e-6,
+    max_iterations: int = 30,
+    min_mode_share: float | None = 0.5,
+) -> NNMResult:
+    """The NNM of ``mode`` at one ε and one amplitude, by Newton shooting on the exact flow.
+
+    Parameters
+    ----------
+    system : UnilateralSystem
+    epsilon : float
+    mode : int
+        1-based mode number j (1 = lowest λ).
+    energy, modal_amplitude, energy_per_epsilon : float
+        Exactly one amplitude condition (see the module docstring).
+    formulation : {"symmetric", "full"}
+        Half-period form for orbits released from rest (default) or the
+        seed's full-period form with the phase condition ``φ_jᵀ M X'(0) = 0``.
+    initial_guess : NNMResult, (X0, T), "linear", "expansion" or None
+        An orbit or a pair ``(X0, T)``: Newton from it, nothing else.
+        ``"linear"``: Newton from the linear mode j with the requested
+        amplitude, ``T = 2π/λ_j``, nothing else.  ``"expansion"``: Newton from
+        the strained-coordinates expansion (:func:`lindstedt.nnm`, order 2:
+        ``ω(ε)`` and the release state ``Φ (a0 e_j + ε a)``) and, if that
+        fails (ε beyond the expansion's validity), continuation in ε
+        (:func:`continue_nnm`, with its resonance jumps) from the largest
+        ``ε/2**k`` where the expansion holds, or from ε = 0.  None (default):
+        Newton from the linear mode, kept only when its orbit is the linear mode
+        or near it (period and release position within 25 %: the weakly
+        nonlinear NNM); otherwise the continuation in ε above — the NNM by its
+        definition, the orbit that grows out of the linear mode (Newton from the
+        linear mode far from it can land on another orbit, or on the NNM run
+        several times).  The message names the route that succeeded; the cost
+        counters include every attempt.
+    release_sign : {1, -1}
+        Energy amplitudes: release on the ``+φ_j`` or ``−φ_j`` side.
+    tol : float
+        Newton tolerance on the scaled residual (and on the scaled step).
+    verify_tol : float
+        Tolerance of the full-period verification of the final state.
+    stability_tol : float
+        Multipliers with ``|μ| > 1 + stability_tol`` make the orbit unstable.
+    max_iterations : int
+    min_mode_share : float or None
+        Reject an orbit whose share of mode j in the modal energy is below
+        this (default 0.5): Newton from a distant guess may converge to
+        another periodic orbit.  None disables the check.
+
+    Returns
+    -------
+    NNMResult
+        ``success`` is False (with the reason in ``message``: every route
+        tried) on an impossible energy, a singular Jacobian, no convergence, a
+        flow failure, a failed verification or a degenerate solution (period
+        collapsed, rest state, not a minimal period that re-solving at T/m could
+        not repair); no exception is raised for those.
+
+    Examples
+    --------
+    The one-dof bilinear oscillator ``u'' + u + ε u_+ = 0`` has
+    ``ω = 2 ω_c / (1 + ω_c)``, ``ω_c = sqrt(1 + ε)``:
+
+    >>> result = nnm_point(UnilateralSystem.one_dof(1), 0.5, 1, modal_amplitude=1.0)
+    >>> result.success, round(result.frequency, 12), round(2 * 1.5**0.5 / (1 + 1.5**0.5), 12)
+    (True, 1.101020514434, 1.101020514434)
+    >>> result.stable, result.n_switches
+    (True, 2)
+    """
+    problem = NNMShooting(system, mode, energy=energy, modal_amplitude=modal_amplitude,
+                          energy_per_epsilon=energy_per_epsilon, formulation=formulation, release_sign=release_sign)
+    epsilon = _check_epsilon(epsilon)
+    shooting_estimate(system, max_iterations + 1, f"NNM point of mode {mode} (shooting)").check()
+    impossible = _impossible_amplitude(problem, epsilon, problem.amplitude)
+    if impossible:
+        return problem._failure(epsilon, impossible)
+    options = dict(tol=tol, max_iterations=max_iterations, verify_tol=verify_tol, stability_tol=stability_tol)
+    if initial_guess is None or isinstance(initial_guess, str):
+        routes = {None: ("linear",), "linear": ("linear",), "expansion": ("expansion",)}
+        if initial_guess not in routes:
+            raise ProblemError(f"initial_guess must be an NNMResult, a pair (X0, T), 'linear', 'expansion' or None, "
+                               f"got {initial_guess!r}")
+        return _robust_point(problem, epsilon, problem.amplitude, options, min_mode_share=min_mode_share,
+                             guesses=routes[initial_guess], homotopy=initial_guess != "linear",
+                             near_linear=initial_guess is None)
+    return problem._solve(_guess_unknowns(problem, epsilon, initial_guess), epsilon,
+                          min_mode_share=min_mode_share, **options)

@@ -53,9 +53,8 @@ from .._errors import ConvergenceError, ParameterError, ProblemError, ResonanceE
 from .._precision import locked
 from ..problems.forced import ForcedOscillator, ForcedSystem, check_forcing_frequency
 from ..problems.piecewise_linear import decompose_piecewise_linear
-from ._period_map import PeriodMapValue
+from ._period_map import PeriodMapValue, linear_frequency_bounds, real_argument
 from .flow import FlowResult, SwitchEvent
-from .forced_setup import _real
 from .switching import _Bracket, _Counters, _earliest_switch, _first_exit, _SearchFailure
 
 __all__ = ["ForcedFlow"]
@@ -151,7 +150,7 @@ class ForcedFlow:
 
     @locked  # the problem's sympy numbers to floats
     def __init__(self, problem: ForcedSystem | ForcedOscillator, epsilon: float, *, max_arcs: int = 1_000_000) -> None:
-        eps = _real(epsilon, "epsilon")
+        eps = real_argument(epsilon, "epsilon")
         if eps < 0.0:
             raise ParameterError(f"epsilon must be ≥ 0 (the size of the nonlinearity and of the load), got {epsilon!r}; e.g. epsilon=0.1")
         self.problem = problem
@@ -518,6 +517,14 @@ class ForcedFlow:
         return evaluate
 
     # ------------------------------------------------------------------ public API
+    def linear_frequencies(self) -> tuple[float, float] | None:
+        """(lowest, highest) frequency of the linear pieces (ω² of each piece: M⁻¹(K + ε·slope)),
+        computed once."""
+        if not hasattr(self, "_bounds"):
+            slopes = [slope for slope, _ in self._intervals] if self._intervals is not None else []
+            self._bounds = linear_frequency_bounds(self.problem, self.epsilon, slopes)
+        return self._bounds
+
     def period_map(
         self, state0: Any, frequency: float, *, periods: int = 1, forcing_scale: float = 1.0, sensitivity: bool = True
     ) -> PeriodMapValue:

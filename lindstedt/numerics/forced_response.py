@@ -48,7 +48,7 @@ import numpy as np
 from .._errors import BudgetError, Cancelled, LindstedtError, ProblemError
 from ..limits import checkpoint
 from ..problems.forced import ForcedOscillator, ForcedSystem, check_forcing_frequency
-from ._period_map import PeriodMap, PeriodMapValue
+from ._period_map import PeriodMap, PeriodMapValue, real_argument
 from .forced_results import Bifurcation, ForcedOrbit, FrequencyResponse
 from .results import _repetitions
 from .forced_setup import (
@@ -59,7 +59,6 @@ from .forced_setup import (
     _linear_guess,
     _multiple_scales_guesses,
     _positive,
-    _real,
     _state,
     _verify,
     forced_flow,
@@ -261,7 +260,7 @@ def forced_periodic_orbit(flow: PeriodMap | ForcedOscillator | ForcedSystem, fre
     flow = _flow_of(flow, epsilon)
     frequency = check_forcing_frequency(frequency, "frequency")
     k = _check_periods(periods)
-    scale = _real(forcing_scale, "forcing_scale")
+    scale = real_argument(forcing_scale, "forcing_scale")
     tol, stability_tol = _positive(tol, "tol"), _positive(stability_tol, "stability_tol")
     _check_cost(flow, frequency, k)
     count = _Counter(flow, k)
@@ -677,7 +676,7 @@ def frequency_response(flow: PeriodMap | ForcedOscillator | ForcedSystem, start:
         for end, name in ((min(start, stop), "start" if start < stop else "stop"),
                           (max(start, stop), "stop" if start < stop else "start")):
             _check_cost(flow, end, k, name)
-        fixed = _real(forcing_scale, "forcing_scale")
+        fixed = real_argument(forcing_scale, "forcing_scale")
         first = forced_periodic_orbit(flow, start, initial_state=initial_state, periods=k, forcing_scale=fixed, tol=tol,
                                       max_iterations=max_iterations, transient_periods=transient_periods,
                                       stability_tol=stability_tol, samples=samples)
@@ -686,7 +685,7 @@ def frequency_response(flow: PeriodMap | ForcedOscillator | ForcedSystem, start:
         if frequency is None:
             raise ProblemError("parameter='forcing' varies the load scale s at a fixed Ω: pass frequency=")
         fixed = omega = check_forcing_frequency(frequency, "frequency")
-        start, stop = _real(start, "start"), _real(stop, "stop")
+        start, stop = real_argument(start, "start"), real_argument(stop, "stop")
         first = forced_periodic_orbit(flow, omega, initial_state=initial_state, periods=k, forcing_scale=start, tol=tol,
                                       max_iterations=max_iterations, transient_periods=transient_periods,
                                       stability_tol=stability_tol, samples=samples)

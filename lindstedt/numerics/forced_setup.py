@@ -23,7 +23,7 @@ import numpy as np
 from .._errors import LindstedtError, ParameterError, ProblemError
 from .._precision import locked
 from ..problems.forced import ForcedOscillator, ForcedSystem
-from ._period_map import PeriodMap
+from ._period_map import PeriodMap, real_argument
 from ..limits import Estimate
 
 __all__ = ["MAX_FREQUENCY_RATIO", "MAX_NATURAL_PERIODS", "VERIFY_TOL", "forced_flow"]
@@ -95,33 +95,10 @@ def forced_flow(problem: ForcedOscillator | ForcedSystem, epsilon: float) -> Per
 
 
 def _linear_frequencies(flow: Any) -> tuple[float, float] | None:
-    """(lowest, highest) frequency of the flow's linear pieces ``ω² = eig(M⁻¹(K + ε·slopes))``; None for a flow
-    that is not one of the package's (nothing is known about its cost)."""
-    problem, eps = getattr(flow, "problem", None), getattr(flow, "epsilon", None)
-    if eps is None:
-        return None
-    try:
-        if isinstance(problem, ForcedOscillator):
-            omega0 = problem.numeric_coefficients()[0]
-            slopes = [0.0]
-            if getattr(flow, "_intervals", None) is not None:
-                slopes += [slope for slope, _ in flow._intervals]
-            elif getattr(flow, "_law", None) is not None:
-                slopes += [float(slope(point)) for _, slope, point in flow._law.pieces]
-            squares = [omega0 * omega0 + eps * slope for slope in slopes]
-        elif isinstance(problem, ForcedSystem):
-            s = problem.system
-            A = np.array(s.A, dtype=float).reshape(-1, s.n_dof)
-            W = np.array(s.W, dtype=float).reshape(s.n_dof, -1)
-            stiffnesses = [s.K] + ([s.K + eps * W @ A] if A.size else [])
-            squares = [float(x) for K in stiffnesses for x in np.linalg.eigvals(np.linalg.solve(s.M, K)).real]
-        else:
-            return None
-    except (LindstedtError, np.linalg.LinAlgError, TypeError, ValueError, OverflowError):
-        return None
-    # a square beyond the float range (ω0 ~ 1e300) is an infinite frequency: far above any forcing (refused there)
-    roots = [math.sqrt(abs(x)) if not math.isnan(x) else math.inf for x in squares if x != 0.0 and not math.isnan(x)]
-    return (min(roots), max(roots)) if roots else None
+    """(lowest, highest) frequency of the flow's linear pieces (its ``linear_frequencies()``); None for a flow that
+    does not report them (nothing is known about its cost)."""
+    report = getattr(flow, "linear_frequencies", None)
+    return report() if callable(report) else None
 
 
 def _check_cost(flow: Any, frequency: float, periods: int, name: str = "frequency") -> None:
@@ -259,19 +236,6 @@ def _positive(value: Any, name: str) -> float:
     return float(value)
 
 
-def _real(value: Any, name: str) -> float:
-    """A finite real number (a float, an int or a numeric string through the one parser), or a
-    :class:`ParameterError` naming the form (the one reading of ε, load scales and ranges of the forced numerics)."""
-    from ..problems.parsing import parse_float
-
-    if isinstance(value, (np.floating, np.integer)):
-        value = value.item()
-    try:
-        return parse_float(value, what=name)
-    except ParameterError:
-        raise
-    except ProblemError as error:
-        raise ParameterError(str(error)) from None
 
 
 def _state(value: Any, dimension: int, name: str = "initial_state") -> np.ndarray:

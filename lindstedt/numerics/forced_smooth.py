@@ -40,10 +40,9 @@ import sympy
 
 from .._errors import ConvergenceError, ProblemError, UnsupportedNonlinearityError
 from ..limits import checkpoint
-from .forced_setup import _real as _real_number
 from .._precision import locked
 from ..problems.forced import ForcedOscillator, ForcedSystem, check_forcing_frequency
-from ._period_map import PeriodMapValue
+from ._period_map import PeriodMapValue, linear_frequency_bounds, real_argument
 
 __all__ = ["SmoothForcedFlow"]
 
@@ -227,7 +226,7 @@ class SmoothForcedFlow:
     @locked  # the problem's sympy numbers to floats, f lambdified
     def __init__(self, problem: ForcedOscillator | ForcedSystem, epsilon: float, *, rtol: float = 1e-12,
                  atol: float = 1e-14) -> None:
-        eps = _real_number(epsilon, "epsilon")
+        eps = real_argument(epsilon, "epsilon")
         if not (isinstance(rtol, (int, float)) and isinstance(atol, (int, float)) and rtol > 0 and atol > 0):
             raise ProblemError(f"rtol and atol must be positive numbers, got rtol={rtol!r}, atol={atol!r}")
         self.problem, self.epsilon, self.rtol, self.atol = problem, eps, float(rtol), float(atol)
@@ -257,10 +256,15 @@ class SmoothForcedFlow:
             raise ProblemError(
                 f"problem must be a ForcedOscillator or a ForcedSystem (lindstedt.problems.forced), got {type(problem).__name__}")
         self.dimension = 2 * self.n_dof
-        from .forced_setup import _linear_frequencies
-
-        self._frequencies = _linear_frequencies(self) or (1.0, 1.0)
+        law = getattr(self, "_law", None)
+        slopes = [float(slope(point)) for _, slope, point in law.pieces] if law is not None else []
+        self._bounds = linear_frequency_bounds(problem, self.epsilon, slopes)
+        self._frequencies = self._bounds or (1.0, 1.0)
         self._load_size = abs(self._load) if self._scalar else float(np.max(np.abs(self._Pm)))
+
+    def linear_frequencies(self) -> tuple[float, float] | None:
+        """(lowest, highest) frequency of the linear pieces (ω² of each piece: ω0² + ε·slope, or M⁻¹(K + ε W A))."""
+        return self._bounds
 
     def _absolute_tolerances(self, z: np.ndarray, frequency: float, scale: float, sensitivity: bool) -> np.ndarray:
         """``atol`` per component: ``min(atol, rtol·size)`` with the size of the displacements
