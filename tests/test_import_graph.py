@@ -1,10 +1,11 @@
-"""The import graph of the package has no new circle (issue 24: a house without circles).
+"""The import graph of the package has no circle (issue 24: a house without circles).
 
 Every ``import`` and ``from … import`` of every module of ``lindstedt/`` — at module level and inside functions
 alike (a deferred import is still a dependency) — is read from the source with ``ast``, and the strongly connected
-components of the graph are the import circles.  The numerics (free and forced periodic orbits, their flows), the
-budget and cost model, the problems, the engine and the algebra have none; the two circles between the results,
-the methods and the export layer are the ones issue 24 still has to cut, listed here so that no other can appear.
+components of the graph are the import circles: there is none.  The layers depend one way — problems, engine and
+algebra below the methods, the methods build results, results never import a method (an unpickled result is
+derived again by the method object it keeps) and the export layer reads results; among the numerics the flows
+report what the drivers need (their linear frequencies) and the drivers import the flows.
 """
 
 from __future__ import annotations
@@ -15,14 +16,6 @@ import pathlib
 import lindstedt
 
 PACKAGE = pathlib.Path(lindstedt.__file__).resolve().parent
-
-#: the circles left (issue 24: results must not import methods or export); none may grow or appear
-REMAINING = {
-    frozenset({"lindstedt.export.codegen", "lindstedt.methods.lindstedt_poincare", "lindstedt.methods.multiple_scales",
-               "lindstedt.results.expansion", "lindstedt.results.frequency_response"}),
-    frozenset({"lindstedt.methods.strained_coordinates", "lindstedt.results.nnm"}),
-}
-
 
 def _name(path: pathlib.Path) -> str:
     parts = list(path.relative_to(PACKAGE.parent).with_suffix("").parts)
@@ -110,9 +103,13 @@ def test_the_reader_sees_deferred_imports():
     assert {"lindstedt.numerics.forced_flow", "lindstedt.numerics.forced_smooth"} <= graph["lindstedt.numerics.forced_setup"]
 
 
-def test_no_import_circle_beyond_the_ones_issue_24_cuts():
-    circles = set(_circles(_graph()))
-    assert circles <= REMAINING, sorted(sorted(circle) for circle in circles - REMAINING)
-    for circle in circles:
-        assert not any(name.split(".")[1] in ("numerics", "problems", "engine", "algebra", "limits", "_budget", "_cost")
-                       for name in circle), sorted(circle)
+def test_no_import_circle():
+    circles = _circles(_graph())
+    assert circles == [], sorted(sorted(circle) for circle in circles)
+
+
+def test_results_import_no_method():
+    graph = _graph()
+    for name, targets in graph.items():
+        if name.startswith("lindstedt.results"):
+            assert not [target for target in targets if target.startswith("lindstedt.methods")], name

@@ -321,12 +321,12 @@ def test_exports_latex_json_code():
     assert data["schema"] == "lindstedt.frequency-response-curve/1"
     assert data["problem"]["f"] == "Max(0, u - 1/5)" and data["order"] == 1
     assert sympy.sympify(data["peak_amplitude"]) == 25 * sympy.Symbol("epsilon")
-    code = curve.generate_code("detuning_upper", "numpy")
+    code = lindstedt.generate_code(curve, "detuning_upper", "numpy")
     amplitudes = np.linspace(0.05, 2.0, 40)
     with np.errstate(invalid="ignore"):  # the generated numpy.select evaluates every piece (NaN beyond the peak)
         generated = code.compile()(amplitudes, 0.1)
     assert np.allclose(generated, curve.detuning(amplitudes, 0.1), rtol=1e-13, equal_nan=True)
-    relation = curve.generate_code("relation", "numpy")
+    relation = lindstedt.generate_code(curve, "relation", "numpy")
     assert relation.arguments == ("A", "sigma", "epsilon")
     assert "FrequencyResponseCurve(" in repr(curve)
 
@@ -334,7 +334,7 @@ def test_exports_latex_json_code():
 @pytest.mark.skipif(shutil.which("cc") is None and shutil.which("gcc") is None, reason="no C compiler")
 def test_generated_c_code():
     curve = frequency_response_curve("u**3", 2, omega0=1, zeta="1/100", forcing=1)
-    compiled = curve.generate_code("detuning_lower", "c").compile()
+    compiled = lindstedt.generate_code(curve, "detuning_lower", "c").compile()
     amplitudes = np.linspace(0.1, 2.0, 20)
     assert np.allclose(compiled(amplitudes, 0.1), curve.detuning(amplitudes, 0.1, "lower"), rtol=1e-12)
 
@@ -373,7 +373,7 @@ def test_errors():
     with pytest.raises(ParameterError, match="branch"):
         curve.stability(1.0, 0.1, "middle")
     with pytest.raises(ProblemError, match="quantity"):
-        curve.generate_code("phase")
+        lindstedt.generate_code(curve, "phase")
     symbolic = frequency_response_curve("u**3")
     with pytest.raises(ParameterError, match="numeric values"):
         symbolic.amplitudes(1.0, 0.1)

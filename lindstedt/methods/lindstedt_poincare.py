@@ -267,12 +267,7 @@ class LindstedtPoincare:
         if problem.has_initial_velocity:  # the copy (== problem) that knows how far its release series goes
             problem = self._released(problem, order)
         return Expansion(problem=problem, order=order, _hierarchy=hierarchy, _form=form,
-                         _method=(self.precision, self.numeric))
-
-
-def _rebuild_expansion(problem: Oscillator, order: int, precision: int, numeric: bool) -> Expansion:
-    """An unpickled :class:`~lindstedt.Expansion`: derived again from its recipe (see ``Expansion.__reduce__``)."""
-    return LindstedtPoincare(precision=precision, numeric=numeric).expand(problem, order)
+                         _method=self)
 
 
 def validate_order(order: Any) -> int:

@@ -476,7 +476,8 @@ class MultipleScales:
             multiple_scales_estimate(problem).check()
         f1, assumptions = first_harmonic(f)
         second = second_order_averaging(f, omega0, _FORCING) if self.order == 2 else None
-        return FrequencyResponseCurve.build(problem, self.order, f1, assumptions, second)
+        slow_flow = first_order_slow_flow(f1, omega0, problem.zeta, problem.forcing)
+        return FrequencyResponseCurve.build(problem, self.order, f1, assumptions, slow_flow, second)
 
 
 @locked

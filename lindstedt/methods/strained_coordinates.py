@@ -96,14 +96,8 @@ class StrainedCoordinatesNNM:
             gauge=steps,
             small_divisors=tuple((k + 1, n, float(d)) for k, n, d in form.small_divisors),
             _hierarchy=hierarchy,
+            _method=self,
         )
-
-
-@locked
-def _rebuild_nnm(problem: NNMProblem, order: int, digits: int) -> NNMExpansion:
-    """An unpickled :class:`~lindstedt.NNMExpansion`: derived again from its recipe (see ``NNMExpansion.__reduce__``)."""
-    precision = digits - modal_guard_digits(problem.system, problem.mode - 1, order)
-    return StrainedCoordinatesNNM(precision).expand(problem, order)
 
 
 def release_amplitudes_by_series(system: UnilateralSystem, mode: int, a0: Any, *, precision: int = 30) -> list[tuple[Any, Any]]:

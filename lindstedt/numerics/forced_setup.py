@@ -23,7 +23,7 @@ import numpy as np
 from .._errors import LindstedtError, ParameterError, ProblemError
 from .._precision import locked
 from ..problems.forced import ForcedOscillator, ForcedSystem
-from ._period_map import PeriodMap, real_argument
+from ._period_map import PeriodMap
 from ..limits import Estimate
 
 __all__ = ["MAX_FREQUENCY_RATIO", "MAX_NATURAL_PERIODS", "VERIFY_TOL", "forced_flow"]

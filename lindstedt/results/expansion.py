@@ -81,10 +81,11 @@ from .accuracy import (
 from .assumptions import DerivationAssumptions, check_names, shown_values
 from .orbit_range import OrbitRange, orbit_range, range_function
 from .._errors import OrderError, ParameterError, ProblemError, UnsupportedNonlinearityError
-from ..export.codegen import stable_function
+from ..export._stable_source import stable_function
 from ..export.stable import compile_family
 from ..problems.parsing import parse_expression, parse_floats, parse_real
 from ..export.json import finite_float
+from ._recipe import derived_again
 from ..export.display import jupyter_latex, labelled_repr, latex_text, shorten
 from ..algebra.branch import Branch, EvaluationPoint
 from ..problems.oscillator import Oscillator, _decided_sign, reduce_quadratic
@@ -541,7 +542,7 @@ class Expansion:
     _hierarchy: SmoothHierarchy | BranchHierarchy = field(repr=False, compare=False)
     _form: NormalForm | PiecewiseNormalForm = field(repr=False, compare=False)
     #: (precision, numeric) of the LindstedtPoincare that derived it: how a process that unpickles it re-derives it
-    _method: tuple[int, bool] = field(default=(30, False), repr=False, compare=False)
+    _method: Any = field(default=None, repr=False, compare=False)  # the method that derived it: its recipe
 
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
         """Pickled as its recipe (problem, order, method): the receiving process re-derives it (lazily, cached
@@ -554,9 +555,9 @@ class Expansion:
         >>> pickle.loads(pickle.dumps(e)).omega == e.omega
         True
         """
-        from ..methods.lindstedt_poincare import _rebuild_expansion
-
-        return _rebuild_expansion, (self.problem, self.order, *self._method)
+        if self._method is None:
+            raise TypeError("an Expansion built without its method cannot be pickled; derive it with lindstedt.expand")
+        return derived_again, (self._method, self.problem, self.order)
 
     @property
     def is_piecewise(self) -> bool:

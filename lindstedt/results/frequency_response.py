@@ -17,8 +17,9 @@ and evaluates them: :meth:`~FrequencyResponseCurve.amplitudes` (every steady amp
 frequency), :meth:`~FrequencyResponseCurve.detuning`, :meth:`~FrequencyResponseCurve.frequency`,
 :meth:`~FrequencyResponseCurve.backbone`, :meth:`~FrequencyResponseCurve.stability`.  It exports
 itself through the one export layer: :meth:`~FrequencyResponseCurve.to_latex`, ``to_json()``
-(:class:`~lindstedt.export.json.JsonExport`), ``_repr_latex_`` and
-:meth:`~FrequencyResponseCurve.generate_code`.
+(:class:`~lindstedt.export.json.JsonExport`) and ``_repr_latex_``; code for its closed forms is
+``lindstedt.generate_code(curve, quantity, language)`` (the export layer reads the result, via
+:meth:`~FrequencyResponseCurve.code_form`).
 """
 
 from __future__ import annotations
@@ -188,11 +189,11 @@ class FrequencyResponseCurve(JsonExport):
         order: int,
         f1: sympy.Expr,
         assumptions: tuple[str, ...],
+        slow_flow: tuple[sympy.Expr, sympy.Expr],
         second: dict[str, Any] | None = None,
     ) -> "FrequencyResponseCurve":
-        """Assemble the closed forms from f1 (and, at order 2, :func:`~lindstedt.methods.multiple_scales.second_order_averaging`)."""
-        from ..methods.multiple_scales import first_order_slow_flow
-
+        """Assemble the closed forms from f1 and the first-order ``slow_flow`` (A', γ') the method derived (and, at
+        order 2, :func:`~lindstedt.methods.multiple_scales.second_order_averaging`)."""
         A, sigma, epsilon = AMPLITUDE, DETUNING, EPSILON
         omega0, zeta, forcing = problem.omega0, problem.zeta, problem.forcing
         g = f1 / A
@@ -206,7 +207,7 @@ class FrequencyResponseCurve(JsonExport):
         trace = -2 * zeta * omega0
         distance = sigma - backbone
         determinant = zeta**2 * omega0**2 + epsilon**2 * distance**2 - epsilon**2 * A * sympy.diff(g, A) * distance / (2 * omega0)
-        flow = first_order_slow_flow(f1, omega0, zeta, forcing)
+        flow = slow_flow
         maximum: sympy.Expr = A
         if second is not None:
             flow, backbone, upper, lower, relation, peak, maximum = _second_order(
@@ -412,10 +413,8 @@ class FrequencyResponseCurve(JsonExport):
     def _first_order_detunings(self) -> dict[str, Callable[..., Any]]:
         """σ±(A) of the first order (the branch a steady state lies on), as NumPy functions of (A, ε)."""
         if "first_detunings" not in self._cache:
-            from ..methods.multiple_scales import first_harmonic
-
             self.problem.numeric_coefficients()
-            f1 = first_harmonic(self.problem.nonlinearity)[0]
+            f1 = self.first_harmonic
             omega0, zeta, forcing = self.problem.omega0, self.problem.zeta, self.problem.forcing
             backbone = f1 / (2 * omega0 * AMPLITUDE)
             radius = sympy.sqrt((forcing / (2 * omega0 * AMPLITUDE)) ** 2 - (zeta * omega0 / EPSILON) ** 2)
@@ -479,9 +478,7 @@ class FrequencyResponseCurve(JsonExport):
         """
         key = "relation_terms"
         if key not in self._cache:
-            from ..methods.multiple_scales import first_harmonic
-
-            f1 = first_harmonic(self.problem.nonlinearity)[0]
+            f1 = self.first_harmonic
             omega0, zeta, forcing = self.problem.omega0, self.problem.zeta, self.problem.forcing
             damping = (2 * omega0**2 * zeta * AMPLITUDE / EPSILON) ** 2
             h1 = damping + (f1 - 2 * omega0 * DETUNING * AMPLITUDE) ** 2 - forcing**2
@@ -597,33 +594,6 @@ class FrequencyResponseCurve(JsonExport):
             ("detuning_upper", shorten(sympy.sstr(self.detuning_upper), 200, "curve.detuning_upper")),
         ]
         return labelled_repr("FrequencyResponseCurve", fields)
-
-    def generate_code(self, quantity: str = "detuning_upper", language: str = "numpy") -> Any:
-        """Code for one closed form of the curve, printed by :mod:`lindstedt.export.codegen` (same targets).
-
-        Parameters
-        ----------
-        quantity : {"detuning_upper", "detuning_lower", "backbone", "first_harmonic", "relation", "determinant"}
-            Vectorised over ``A``; arguments ``(A, epsilon, *symbols)``, and ``(A, sigma, epsilon, *symbols)``
-            for ``"relation"`` and ``"determinant"``.
-        language : {"numpy", "c", "octave", "julia", "fortran", "rust", "jax"}
-
-        Returns
-        -------
-        GeneratedCode
-
-        Examples
-        --------
-        >>> from lindstedt.methods.multiple_scales import frequency_response_curve
-        >>> code = frequency_response_curve("u**3", omega0=1, zeta="1/100", forcing=1).generate_code("detuning_upper")
-        >>> code.arguments
-        ('A', 'epsilon')
-        >>> round(float(code.compile()(1.0, 0.1)), 6)
-        0.864898
-        """
-        from ..export.codegen import generate_code
-
-        return generate_code(self, quantity, language)
 
     def code_form(self, quantity: str) -> tuple[list[sympy.Symbol], sympy.Symbol, sympy.Expr]:
         """(arguments, the vectorised argument, the exact closed form) of ``quantity``: what code generation prints

@@ -9,7 +9,6 @@ contact angles; exports to JSON (schema ``lindstedt.nnm/1``) and LaTeX.
 from __future__ import annotations
 
 import json
-import warnings
 from dataclasses import dataclass, field
 from .._precision import cached_property, locked_methods, warn_caller
 from typing import Any
@@ -34,6 +33,7 @@ from .accuracy import (
 from ..problems.nnm import NNMProblem
 from ..problems.parsing import parse_floats
 from ..problems.system import UnilateralSystem
+from ._recipe import derived_again
 
 __all__ = ["NNMExpansion"]
 
@@ -93,9 +93,10 @@ class NNMExpansion:
     small_divisors: tuple[tuple[int, int, float], ...]
     gauge: int
     _hierarchy: BranchHierarchy = field(repr=False, compare=False)
+    _method: Any = field(default=None, repr=False, compare=False)  # the method that derived it: its recipe
 
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
-        """Pickled as its recipe (problem, order, working digits): the receiving process derives it again.
+        """Pickled as its recipe (the method that derived it, problem, order): the receiving process derives it again.
 
         Examples
         --------
@@ -104,9 +105,9 @@ class NNMExpansion:
         >>> pickle.loads(pickle.dumps(mode)).omega == mode.omega
         True
         """
-        from ..methods.strained_coordinates import _rebuild_nnm
-
-        return _rebuild_nnm, (self.problem, self.order, self.digits)
+        if self._method is None:
+            raise TypeError("an NNMExpansion built without its method cannot be pickled; derive it with lindstedt.nnm")
+        return derived_again, (self._method, self.problem, self.order)
 
     @property
     def system(self) -> UnilateralSystem:
