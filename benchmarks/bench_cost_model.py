@@ -126,7 +126,7 @@ def fit(rows: list[dict[str, Any]]) -> tuple[dict[str, dict[str, float]], tuple[
         breakpoints = dict(estimate.drivers).get("breakpoints", 1)
         seconds = max(row["seconds"], 1e-3)
         by_kind.setdefault(kind, []).append((vector, seconds))
-        if row["memory_mb"] > 2.0 and seconds > 0.2:
+        if (row.get("memory_mb") or 0.0) > 2.0 and seconds > 0.2:
             digits = dict(estimate.drivers).get("digits", 30)
             memory.append((math.log(seconds), math.log(breakpoints), math.log(digits / 30), math.log(row["memory_mb"])))
     theta = {}

@@ -35,7 +35,7 @@ _SWITCHES = (sympy.Max, sympy.Min, sympy.Heaviside, sympy.Abs, sympy.sign)
 #: The features each kind's model uses (the measurements show no dependence on the others).
 FEATURES_OF_KIND: dict[str, tuple[str, ...]] = {
     "polynomial": ("1", "n", "n2", "degree", "degree_n", "symbols", "symbols_n", "scale", "scale_n", "velocity"),
-    "analytic": ("1", "n", "n2", "p", "p_n", "p2"),
+    "analytic": ("1", "n", "n2", "p", "p_n", "p_n2", "p2"),
     "piecewise": ("1", "n", "n2", "b", "b_n", "b2", "symbols", "symbols_n", "scale", "scale_n", "degree", "dn", "dn2",
                   "origin", "origin_n", "velocity"),
     "piecewise-float": ("1", "n", "b", "p", "p_n"),
@@ -43,20 +43,20 @@ FEATURES_OF_KIND: dict[str, tuple[str, ...]] = {
 }
 #: θ per kind: {feature: coefficient} over :data:`FEATURES_OF_KIND` (fitted, see the module docstring).
 _THETA: dict[str, dict[str, float]] = {
-    "polynomial": {"1": -3.0151, "n": -2.7361, "n2": 0.5072, "degree": -2.3599, "degree_n": 1.4444,
-                  "symbols": 0.2257, "symbols_n": 0.7629, "scale": 1.4507, "scale_n": -0.2183, "velocity": 1.9369},
-    "analytic": {"1": -3.5351, "n": -0.9345, "n2": 0.6741, "p": -0.6122, "p_n": 0.0629, "p2": 0.6052},
-    "piecewise": {"1": -5.5305, "n": -0.6708, "n2": 0.7062, "b": -1.1632, "b_n": 1.6953, "b2": 0.4526,
-                 "symbols": 1.1137, "symbols_n": 0.6166, "scale": -1.5165, "scale_n": 3.4173, "degree": -0.8743,
-                 "dn": 0.5223, "dn2": 0.2934, "origin": 0.4123, "origin_n": -0.7645, "velocity": 0.2298},
+    "polynomial": {"1": -1.9237, "n": -3.3032, "n2": 0.5684, "degree": -2.7309, "degree_n": 1.5775,
+                  "symbols": 0.0373, "symbols_n": 0.8608, "scale": 1.3214, "scale_n": -0.1717, "velocity": 1.9378},
+    "analytic": {"1": -1.8177, "n": -2.4222, "n2": 0.9825, "p": -1.1955, "p_n": 0.2089, "p_n2": 0.0217, "p2": 0.6769},
+    "piecewise": {"1": -5.2824, "n": -1.4166, "n2": 0.7951, "b": -1.2412, "b_n": 1.7515, "b2": 0.4558,
+                 "symbols": 1.0835, "symbols_n": 0.6406, "scale": -1.5709, "scale_n": 3.4578, "degree": -1.2225,
+                 "dn": 0.9739, "dn2": 0.2821, "origin": 0.443, "origin_n": -0.7766, "velocity": 0.2721},
     "piecewise-float": {"1": -7.8879, "n": 2.1409, "b": 0.7186, "p": 0.3286, "p_n": -0.1632},
     "contact-law": {"1": -2.7991, "n": 0.9765, "p": 1.8169, "p_n": -0.0145},
 }
-#: The fewest digits a method works at (LindstedtPoincare's precision ≥ 15).
-_LEAST_DIGITS = 15
+#: The fewest digits the model is fitted at (the default precision): fewer are priced as these (conservative).
+_LEAST_DIGITS = 30
 #: memory growth (MB) = _MEMORY[0] · T^_MEMORY[1] · B^_MEMORY[2] · (P/30)^_MEMORY[3] (B ≥ 1 the breakpoints, P the
 #: digits), never below 1 MB
-_MEMORY = (9.265, 0.682, 0.526, 0.071)
+_MEMORY = (9.196, 0.656, 0.541, 0.086)
 
 
 @dataclass(frozen=True)
@@ -91,18 +91,19 @@ class ExpansionFeatures:
             "1": 1.0, "n": n, "n2": n * n, "degree": degree, "degree_n": degree * n, "dn": dn, "dn2": dn * dn,
             "origin": float(self.origin), "origin_n": float(self.origin) * n, "b": b, "b_n": b * n, "b2": b * b,
             "symbols": float(self.symbols), "symbols_n": self.symbols * n, "scale": scale, "scale_n": scale * n,
-            "p": p, "p_n": p * n, "p2": p * p, "velocity": float(self.initial_velocity),
+            "p": p, "p_n": p * n, "p_n2": p * n * n, "p2": p * p, "velocity": float(self.initial_velocity),
         }
 
     def log_seconds(self) -> float:
         """log T: the fitted model made monotone — the most it gives over every lower order (from 1), fewer digits
-        (down to the least a method takes) and fewer breakpoints, so that asking for more never prices less."""
+        (down to 30, the fewest it was fitted at; fewer are priced as 30) and fewer breakpoints, so that asking for
+        more never prices less."""
         theta = _THETA[self.kind]
         best = -math.inf
         for coefficients in range(min(1, self.coefficients), self.coefficients + 1):  # order 0 alone: no fit below 1
-            for digits in {_LEAST_DIGITS, self.digits}:
+            for digits in {_LEAST_DIGITS, max(self.digits, _LEAST_DIGITS)}:
                 for breakpoints in {1, self.breakpoints}:
-                    vector = self.vector(coefficients, min(digits, self.digits), breakpoints)
+                    vector = self.vector(coefficients, digits, breakpoints)
                     best = max(best, sum(value * vector[name] for name, value in theta.items()))
         return best
 

@@ -40,7 +40,7 @@ True
 ...     lindstedt.expand("Max(0, u - 1/3)", order=30, a0=1, omega0=1)
 Traceback (most recent call last):
 ...
-lindstedt._errors.BudgetError: expansion of Max(0, u - 1/3) to order 30: ~... estimated (within a factor 4), above the time budget of 10 s: ...
+lindstedt._errors.BudgetError: expansion of Max(0, u - 1/3) to order 30: ~... estimated (within a factor 5), above the time budget of 10 s: ...
 """
 
 from . import _budget
@@ -48,8 +48,8 @@ from ._budget import *  # noqa: F403 - exactly the names of _budget.__all__
 
 __all__ = list(_budget.__all__)
 
-#: How far a measured cost may lie from its estimate on the benchmark machine, either way: the ratios that
-#: ``benchmarks/bench_cost_model.py`` measured lie in [0.21, 3.13] for time and [0.30, 3.59] for memory.
+#: How far a measured cost may lie from its estimate on the benchmark machine, either way: the ratios measured by
+#: ``benchmarks/bench_cost_model.py`` (see ``benchmarks/README.md``) lie within it for time and memory.
 FACTOR = _budget.FACTOR
 #: The budget in force outside any ``with budget(...)`` block until :func:`set_default` changes it: 600 s, 2048 MB.
 DEFAULT = _budget.DEFAULT
