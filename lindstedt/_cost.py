@@ -12,9 +12,9 @@ show the exponent of N to depend on them — and θ holds one fitted vector per 
 * ``contact-law`` — a non-polynomial contact law (Hertz), its contact arc solved in stretched time at P digits.
 
 Memory is ``growth = c · T^γ · B^δ · (P/30)^η`` MB over the process (one fit over every kind, B ≥ 1 the
-breakpoints, P the digits).  The constants come
-from ``benchmarks/bench_cost_model.py --fit``, which measures a calibration set of requests on the
-benchmark machine (the ratio measured/estimated stays within :data:`lindstedt.limits.FACTOR` there).
+breakpoints, P the digits).  The constants come from ``benchmarks/bench_cost_model.py --fit --from-json
+benchmarks/results/cost_model_calibration.json`` — least squares on the requests measured there on the benchmark
+machine, where the ratio measured/estimated stays within :data:`lindstedt.limits.FACTOR`.
 """
 
 from __future__ import annotations
