@@ -228,15 +228,24 @@ def budget(seconds: Any = _KEEP, memory_mb: Any = _KEEP, *, cancel: Any = None,
         _WATCH.reset(token)
 
 
-def _bars() -> Callable[[Progress], Any] | None:
-    """A ``progress`` callback drawing one tqdm bar per stage (orders, continuation points, ...); None, with a
-    warning naming ``pip install tqdm``, when tqdm is missing."""
+def tqdm_or_warn() -> Any:
+    """tqdm's bar class for ``progress=True``; None, with a warning naming ``pip install tqdm`` (attributed to the
+    caller's line), when the optional dependency is missing (the budget's bars and the sweeps' bar)."""
     try:
         from tqdm.auto import tqdm
     except ImportError:
-        import warnings
+        from ._precision import warn_caller
 
-        warnings.warn("progress=True needs tqdm: pip install tqdm (no progress shown)", stacklevel=4)
+        warn_caller(UserWarning("progress=True needs tqdm: pip install tqdm (no progress bar shown)"))
+        return None
+    return tqdm
+
+
+def _bars() -> Callable[[Progress], Any] | None:
+    """A ``progress`` callback drawing one tqdm bar per stage (orders, continuation points, ...); None when tqdm is
+    missing (:func:`tqdm_or_warn`)."""
+    tqdm = tqdm_or_warn()
+    if tqdm is None:
         return None
     bars: dict[str, Any] = {}
 

@@ -73,19 +73,18 @@ class ExpansionFeatures:
     initial_velocity: bool
     origin: bool = False
 
-    @property
-    def coefficients(self) -> int:
-        """The highest order solved (grazing, whose gauge √ε doubles the indices, measured no dearer: not priced)."""
-        return self.order
-
-    def vector(self, coefficients: int | None = None, digits: int | None = None,
+    def vector(self, order: int | None = None, digits: int | None = None,
                breakpoints: int | None = None) -> dict[str, float]:
-        """The features x of the model ``log T = θ · x`` (at other coefficients, digits or breakpoints if given)."""
-        n = math.log((self.coefficients if coefficients is None else coefficients) + 1)
+        """The features x of the model ``log T = θ · x`` (at another order, digits or breakpoints if given).
+
+        Grazing, whose gauge √ε doubles the coefficient indices, measured no dearer than its order: not priced.
+        """
+        order = self.order if order is None else order
+        n = math.log(order + 1)
         b = math.log(max(self.breakpoints if breakpoints is None else breakpoints, 1))
         p = math.log((self.digits if digits is None else digits) / 30)
         degree = math.log(max(self.degree, 1))
-        dn = math.log(max(self.degree, 1) * (self.coefficients if coefficients is None else coefficients) + 1)
+        dn = math.log(max(self.degree, 1) * order + 1)
         scale = float(self.symbolic_scale)
         return {
             "1": 1.0, "n": n, "n2": n * n, "degree": degree, "degree_n": degree * n, "dn": dn, "dn2": dn * dn,
@@ -100,10 +99,10 @@ class ExpansionFeatures:
         more never prices less."""
         theta = _THETA[self.kind]
         best = -math.inf
-        for coefficients in range(min(1, self.coefficients), self.coefficients + 1):  # order 0 alone: no fit below 1
+        for order in range(min(1, self.order), self.order + 1):  # order 0 alone: no fit below 1
             for digits in {_LEAST_DIGITS, max(self.digits, _LEAST_DIGITS)}:
                 for breakpoints in {1, self.breakpoints}:
-                    vector = self.vector(coefficients, digits, breakpoints)
+                    vector = self.vector(order, digits, breakpoints)
                     best = max(best, sum(value * vector[name] for name, value in theta.items()))
         return best
 

@@ -39,6 +39,7 @@ the same property of another instance); a value computed twice by two threads is
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import os
 import sys
@@ -219,7 +220,8 @@ _PACKAGE = os.path.dirname(os.path.abspath(__file__)) + os.sep
 
 def warn_caller(warning: Warning) -> None:
     """``warnings.warn(warning)`` attributed to the first frame outside the package — the user's call — however
-    many of the package's frames (the lock's wrappers among them) lie between.
+    many of the package's frames (the lock's wrappers among them, and contextlib's around a ``with`` block of the
+    package) lie between.
 
     Examples
     --------
@@ -231,7 +233,8 @@ def warn_caller(warning: Warning) -> None:
     ('checked', False)
     """
     frame, level = sys._getframe(0), 1
-    while frame.f_back is not None and frame.f_code.co_filename.startswith(_PACKAGE):
+    while frame.f_back is not None and (frame.f_code.co_filename.startswith(_PACKAGE)
+                                        or frame.f_code.co_filename == contextlib.__file__):
         frame, level = frame.f_back, level + 1
     warnings.warn(warning, stacklevel=level)
 

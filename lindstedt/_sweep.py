@@ -20,7 +20,7 @@ import contextvars
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Callable, Iterable, Sequence, TypeVar
 
-from .limits import checkpoint
+from ._budget import checkpoint, tqdm_or_warn
 
 __all__ = ["sweep_map"]
 
@@ -33,12 +33,8 @@ def _reporter(progress: Any, total: int, description: str) -> tuple[Callable[[in
         return (lambda *_: None), (lambda: None)
     if callable(progress):
         return progress, (lambda: None)
-    try:
-        from tqdm.auto import tqdm
-    except ImportError:
-        import warnings
-
-        warnings.warn("progress=True needs tqdm: pip install tqdm (no progress bar shown)", stacklevel=4)
+    tqdm = tqdm_or_warn()
+    if tqdm is None:
         return (lambda *_: None), (lambda: None)
     bar = tqdm(total=total, desc=description, unit="point")
     return (lambda *_: bar.update(1)), bar.close

@@ -192,30 +192,22 @@ def _add_budget_options(command: argparse.ArgumentParser) -> None:
 
 
 def _command_expand(arguments: argparse.Namespace) -> str:
-    if arguments.order < HIGH_ORDER and _expand_cost(arguments).seconds < PROGRESS_SECONDS:
-        return _expand_output(arguments)
+    from ..methods.lindstedt_poincare import LindstedtPoincare
+    from ..problems.oscillator import Oscillator
+
+    problem = Oscillator(arguments.f, a0=arguments.a0, omega0=arguments.omega0,
+                         params=_parse_parameters(arguments.param), normalization=arguments.normalization,
+                         a1=arguments.a1, u0=arguments.u0, v0=arguments.v0)
+    method = LindstedtPoincare(precision=arguments.precision)
+    if arguments.order < HIGH_ORDER and method.estimate(problem, arguments.order).seconds < PROGRESS_SECONDS:
+        return _expand_output(arguments, method.expand(problem, arguments.order))
     with Progress("expand", total=arguments.order + 2, unit="step") as progress:
-        text = _expand_output(arguments, progress)
+        text = _expand_output(arguments, method.expand(problem, arguments.order), progress)
         progress.summary = f"orders 0-{arguments.order}"
     return text
 
 
-def _expand_arguments(arguments: argparse.Namespace) -> dict[str, Any]:
-    return dict(order=arguments.order, a0=arguments.a0, omega0=arguments.omega0,
-                params=_parse_parameters(arguments.param), normalization=arguments.normalization,
-                precision=arguments.precision, a1=arguments.a1, u0=arguments.u0, v0=arguments.v0)
-
-
-def _expand_cost(arguments: argparse.Namespace) -> Any:
-    from ..methods.lindstedt_poincare import expansion_cost
-
-    return expansion_cost(arguments.f, **_expand_arguments(arguments))
-
-
-def _expand_output(arguments: argparse.Namespace, progress: Progress | None = None) -> str:
-    from ..methods.lindstedt_poincare import expand
-
-    expansion = expand(arguments.f, **_expand_arguments(arguments))
+def _expand_output(arguments: argparse.Namespace, expansion: Any, progress: Progress | None = None) -> str:
     if progress is not None:  # the orders one by one (the hierarchy is lazy), then the output
         for k in range(arguments.order + 1):
             progress.update(status=f"order {k}")
