@@ -41,6 +41,7 @@ REGISTRY: dict[str, tuple[str, str]] = {
     "cost-model": ("bench_cost_model", "run"),
     "performance": ("bench_performance", "run"),
     "forced": ("bench_forced", "run"),
+    "orbit-core": ("bench_orbit_core", "run"),
 }
 
 
