@@ -303,7 +303,7 @@ def test_no_module_but_the_parser_turns_text_into_sympy():
             if not isinstance(node, ast.Call):
                 continue
             name = node.func.attr if isinstance(node.func, ast.Attribute) else getattr(node.func, "id", "")
-            if name in {"eval", "parse_expr", "S", "mpmathify"} and not (name == "mpmathify" and name_in_package == "references/quadrature.py"):
+            if name in {"eval", "parse_expr", "S", "mpmathify"} and not (name == "mpmathify" and name_in_package in ("references/arguments.py", "references/breakpoints.py", "references/trapezoid.py")):
                 offenders.append(f"{name_in_package}:{node.lineno} {name}")
             # the code generator and the stable-series compiler run the source they generated themselves
             if name == "exec" and name_in_package not in ("export/codegen.py", "export/_stable_source.py"):

@@ -57,13 +57,9 @@ from .piecewise import (
     piecewise_linear_frequency_taylor,
     piecewise_linear_frequency_taylor_symbolic,
 )
-from .quadrature import (
-    as_mpmath_number,
-    conservative_frequency,
-    conservative_period,
-    frequency_taylor_coefficients,
-    nonlinearity_breakpoints,
-)
+from .arguments import as_mpmath_number
+from .chebyshev import frequency_taylor_coefficients
+from .quadrature import conservative_frequency, conservative_period, nonlinearity_breakpoints
 
 __all__ = [
     "duffing_exact_frequency",

@@ -75,8 +75,8 @@ from sympy.polys.ring_series import (
 from sympy.polys.rings import ring
 
 from .._errors import ConvergenceError, ProblemError
-from .quadrature import omega0_parameter, real_parameter, validate_precision, validate_order
 from .._precision import locked, workdps
+from .arguments import omega0_parameter, real_parameter, validate_order, validate_precision
 
 __all__ = ["duffing_exact_frequency", "duffing_frequency_taylor"]
 

@@ -60,13 +60,13 @@ import sympy
 
 from .._errors import ConvergenceError, ProblemError
 from .._precision import locked, workdps
-from .quadrature import (
+from .arguments import (
     as_mpmath_number,
     omega0_parameter,
     real_parameter,
     rounded_coefficients,
-    validate_precision,
     validate_order,
+    validate_precision,
 )
 
 __all__ = [
