@@ -4,6 +4,8 @@
 * :mod:`~lindstedt.problems.oscillator` — ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0``, ``u'(0) = 0``;
 * :mod:`~lindstedt.problems.piecewise_linear` — a continuous piecewise-linear f split into linear intervals;
 * :mod:`~lindstedt.problems.system` — ``M X'' + K X + ε W (A X − b)_+ = 0`` and its linear modes;
+* :mod:`~lindstedt.problems.matrices` — exact matrices read from user input, and their float copies;
+* :mod:`~lindstedt.problems.modes` — the linear modes ``K Φ = M Φ diag(λ²)``, float64 then multiprecision;
 * :mod:`~lindstedt.problems.nnm` — the NNM of one mode of such a system.
 
 The public names are re-exported by :mod:`lindstedt`.

@@ -28,7 +28,8 @@ from .._errors import ParameterError, ProblemError
 from .._precision import locked, locked_methods
 from .oscillator import Oscillator
 from .parsing import parse_real
-from .system import UnilateralSystem, _exact_matrix, _exact_scalar, _float_array
+from .matrices import _exact_matrix, _exact_scalar, _float_array
+from .system import UnilateralSystem
 
 __all__ = ["ForcedOscillator", "ForcedSystem", "check_forcing_frequency"]
 

@@ -17,27 +17,24 @@
 ``0.1`` as its exact binary value) and as a read-only float ``numpy`` array (the correctly rounded
 values of the exact entries).  The N-dof setting is section 4 of the seed
 paper, whose force term ``ε (Ã X − B)_+`` is the special case ``W = I``.
+The entries are read by :mod:`~lindstedt.problems.matrices` and the linear modes computed by
+:mod:`~lindstedt.problems.modes`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from fractions import Fraction
 from typing import Any, Iterable, Mapping, NamedTuple, Sequence
 
-import mpmath
 import numpy as np
 import sympy
 
 from .._errors import ProblemError
-from .parsing import parse_real
-from .._precision import cached_property, locked, locked_methods, workdps, workprec
+from .._precision import cached_property, locked, locked_methods
+from .matrices import _check_symmetric_positive_definite, _exact_matrix, _exact_scalar, _exactly_equal, _float_array
+from .modes import _float_modes, _high_precision_modes, _modal_coupling
 
 __all__ = ["UnilateralSystem", "Modes", "OneDofUnilateral"]
-
-# Two entries of a mode shape whose magnitudes agree to this relative
-# tolerance count as tied for "largest" in the sign convention of modes().
-_MODE_SIGN_TIE_RTOL = 1e-9
 
 _JSON_KEYS = ("M", "K", "A", "b", "W")
 
@@ -55,124 +52,6 @@ class Modes(NamedTuple):
 
     frequencies: np.ndarray
     shapes: np.ndarray
-
-
-def _leading_sign(column: Sequence[Any]) -> int:
-    """±1 making the first entry of largest magnitude (ties within a relative 1e-9) positive."""
-    largest = max(abs(value) for value in column)
-    for value in column:
-        if abs(value) >= largest * (1 - _MODE_SIGN_TIE_RTOL):
-            return 1 if value > 0 else -1
-    return 1
-
-
-# --------------------------------------------------------------------------- #
-# exact conversion of user input
-# --------------------------------------------------------------------------- #
-def _exact_scalar(value: Any, what: str) -> sympy.Expr:
-    """One entry as an exact, finite, real sympy number (read by the one parser; a float is its binary value)."""
-    if isinstance(value, np.bool_):
-        raise ProblemError(f"{what} is a boolean ({value}); give a number such as 1, 0.5 or '1/3'")
-    if isinstance(value, np.generic):
-        value = value.item()
-    # fast paths (what parse_real returns for them, without its printing): the N² entries of a large system
-    if type(value) is int and -(2**62) < value < 2**62:
-        return sympy.Integer(value)
-    if isinstance(value, sympy.Rational) and int(value.p).bit_length() + int(value.q).bit_length() <= 128:
-        return value
-    return parse_real(value, what=what)
-
-
-def _exact_to_float(expr: sympy.Expr) -> float:
-    """Correctly rounded float of an exact number."""
-    if isinstance(expr, sympy.Rational):
-        return float(Fraction(int(expr.p), int(expr.q)))
-    return float(sympy.N(expr, 40))
-
-
-def _exact_matrix(value: Any, name: str, *, ndim: int) -> sympy.ImmutableMatrix:
-    """Convert nested sequences / numpy arrays / sympy matrices (ndim 1 or 2)."""
-    if isinstance(value, sympy.MatrixBase) and ndim == 2:
-        # by its nonzero entries (a large banded system converts in O(nonzeros)); zeros are exact
-        converted = {(i, j): _exact_scalar(entry, f"{name}[{i}, {j}]") for (i, j), entry in sorted(value.todok().items())}
-        return sympy.ImmutableMatrix(sympy.SparseMatrix(value.rows, value.cols, converted))
-    if isinstance(value, sympy.MatrixBase):
-        rows = value.tolist()
-        if ndim == 1:
-            if value.cols == 1:
-                rows = [row[0] for row in rows]
-            elif value.rows == 1:
-                rows = list(rows[0]) if rows else []
-            else:
-                raise ProblemError(f"{name} must be a vector, got a {value.rows}×{value.cols} matrix")
-        value = rows
-    if isinstance(value, np.ndarray):
-        if value.dtype.kind == "c":
-            raise ProblemError(f"{name} is complex; the matrices of the system must be real")
-        if value.ndim != ndim:
-            raise ProblemError(
-                f"{name} must be {'a vector (1-D)' if ndim == 1 else 'a matrix (2-D)'}, "
-                f"got an array of shape {value.shape}"
-            )
-        value = value.tolist()
-    if isinstance(value, (str, bytes)) or not isinstance(value, (Sequence, np.ndarray)):
-        raise ProblemError(
-            f"{name} must be {'a vector' if ndim == 1 else 'a matrix'} given as nested lists, a numpy array "
-            f"or a sympy Matrix, got {type(value).__name__}"
-        )
-    if ndim == 1:
-        entries = [_exact_scalar(entry, f"{name}[{i}]") for i, entry in enumerate(value)]
-        return sympy.ImmutableMatrix(len(entries), 1, entries)
-    rows = list(value)
-    if not rows:
-        return sympy.ImmutableMatrix(0, 0, [])
-    widths = set()
-    for i, row in enumerate(rows):
-        if isinstance(row, (str, bytes)) or not isinstance(row, (Sequence, np.ndarray)):
-            raise ProblemError(
-                f"{name} must be a matrix (a list of rows); row {i} is {row!r}. "
-                f"Wrap a single row in brackets, e.g. {name}=[[1, 0]]"
-            )
-        widths.add(len(row))
-    if len(widths) != 1:
-        raise ProblemError(f"the rows of {name} have different lengths {sorted(widths)}; every row needs the same length")
-    entries = [_exact_scalar(entry, f"{name}[{i}, {j}]") for i, row in enumerate(rows) for j, entry in enumerate(row)]
-    return sympy.ImmutableMatrix(len(rows), widths.pop(), entries)
-
-
-def _float_array(matrix: sympy.ImmutableMatrix, *, vector: bool = False) -> np.ndarray:
-    array = np.zeros((matrix.rows, matrix.cols))
-    for (i, j), value in matrix.todok().items():
-        array[i, j] = _exact_to_float(value)
-    array = array.reshape(matrix.rows, matrix.cols)
-    if vector:
-        array = array.reshape(matrix.rows)
-    array.setflags(write=False)
-    return array
-
-
-def _exactly_equal(first: sympy.Expr, second: sympy.Expr) -> bool:
-    return first == second or sympy.simplify(first - second) == 0
-
-
-def _check_symmetric_positive_definite(exact: sympy.ImmutableMatrix, numeric: np.ndarray, name: str, role: str) -> None:
-    entries = exact.todok()  # the nonzero entries: a large banded matrix is checked in O(nonzeros)
-    for i, j in sorted(set(entries) | {(j, i) for i, j in entries}):
-        if i < j:
-            if not _exactly_equal(exact[i, j], exact[j, i]):
-                raise ProblemError(
-                    f"{name} ({role}) must be symmetric but {name}[{i}, {j}] = {exact[i, j]} while "
-                    f"{name}[{j}, {i}] = {exact[j, i]}; if the difference is rounding, pass ({name} + {name}.T)/2"
-                )
-    try:
-        np.linalg.cholesky(numeric)
-    except np.linalg.LinAlgError:
-        smallest = float(np.linalg.eigvalsh(numeric)[0])
-        raise ProblemError(
-            f"{name} ({role}) must be positive definite but its Cholesky factorisation fails "
-            f"(smallest eigenvalue ≈ {smallest:.3g}); check the signs of its diagonal and that no "
-            "degree of freedom is left without mass or spring"
-        ) from None
 
 
 def _json_entry(expr: sympy.Expr) -> str:
@@ -468,8 +347,6 @@ class UnilateralSystem:
     @cached_property
     def _modes(self) -> Modes:
         frequencies, shapes = _float_modes(self.M, self.K)
-        for k in range(self.n_dof):
-            shapes[:, k] *= _leading_sign(shapes[:, k].tolist())
         frequencies.setflags(write=False)
         shapes.setflags(write=False)
         return Modes(frequencies, shapes)
@@ -497,15 +374,7 @@ class UnilateralSystem:
         """
         if isinstance(digits, bool) or not isinstance(digits, int) or digits < 1:
             raise ProblemError(f"digits must be a positive integer, got {digits!r}")
-        refined = _refined_modes(self, digits)
-        if refined is None:
-            return _dense_mpmath_modes(self, digits)
-        with workprec(refined.bits):
-            frequencies = refined.frequencies()
-            roots = [mpmath.sqrt(norm) for norm in refined.norms]
-            shapes = [[mpmath.mpf(int(value)) / root for value in refined.X[:, k]] for k, root in enumerate(roots)]
-        with workdps(digits):
-            return [+value for value in frequencies], [[+value for value in column] for column in shapes]
+        return _high_precision_modes(self, digits)
 
     @locked
     def modal_coupling(self, digits: int) -> tuple[list[Any], list[list[Any]], list[list[Any]]]:
@@ -531,27 +400,9 @@ class UnilateralSystem:
             raise ProblemError(f"digits must be a positive integer, got {digits!r}")
         cache = self.__dict__.setdefault("_coupling_cache", {})  # O(N·m) numbers per precision (frozen: not a field)
         if digits not in cache:
-            cache[digits] = self._modal_coupling(digits)
+            cache[digits] = _modal_coupling(self, digits)
         frequencies, B, G = cache[digits]
         return list(frequencies), [list(row) for row in B], [list(row) for row in G]
-
-    def _modal_coupling(self, digits: int) -> tuple[list[Any], list[list[Any]], list[list[Any]]]:
-        refined = _refined_modes(self, digits)
-        if refined is None:
-            frequencies, columns = _dense_mpmath_modes(self, digits)
-            with workdps(digits + 10):
-                A = [[_exact_mpf(v) for v in row] for row in self.A_exact.tolist()]
-                W = [[_exact_mpf(v) for v in row] for row in self.W_exact.tolist()]
-                B = [[+mpmath.fdot(row, column) for column in columns] for row in A]
-                G = [[+mpmath.fdot(column, (W[r][i] for r in range(self.n_dof))) for i in range(self.n_springs)] for column in columns]
-            with workdps(digits):
-                return frequencies, [[+v for v in row] for row in B], [[+v for v in row] for row in G]
-        with workprec(refined.bits):
-            frequencies = refined.frequencies()
-            B = refined.projections(self.A_exact)
-            G = [list(column) for column in zip(*refined.projections(self.W_exact.T))] if self.n_springs else [[] for _ in range(self.n_dof)]
-        with workdps(digits):
-            return [+value for value in frequencies], [[+value for value in row] for row in B], [[+value for value in row] for row in G]
 
     def modes(self) -> Modes:
         """Linear normal modes: ``K Φ = M Φ diag(λ²)`` with ``Φᵀ M Φ = I``.
@@ -621,234 +472,6 @@ class UnilateralSystem:
         contact = 0.5 * epsilon * np.sum(np.maximum(self.gaps(positions), 0.0) ** 2, axis=-1)
         total = kinetic + potential + contact
         return float(total) if np.ndim(total) == 0 else total
-
-
-# --------------------------------------------------------------------------- #
-# modes: float64, then refined in multiprecision
-# --------------------------------------------------------------------------- #
-def _float_modes(M: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """λ and Φ (ΦᵀMΦ = I) in float64: LAPACK's tridiagonal / banded solvers when M is diagonal, else dense."""
-    import scipy.linalg  # here, not at module level: import lindstedt stays light
-
-    n = M.shape[0]
-    if np.count_nonzero(M - np.diag(np.diag(M))) == 0:
-        scale = 1 / np.sqrt(np.diag(M))
-        scaled = K * scale[:, None] * scale[None, :]
-        rows, cols = np.nonzero(scaled)
-        width = int(np.max(np.abs(rows - cols))) if rows.size else 0
-        if n > 1 and width == 1:
-            squared, vectors = scipy.linalg.eigh_tridiagonal(np.diag(scaled).copy(), np.diag(scaled, 1).copy())
-        elif n > 1 and 1 < width < n // 4:
-            band = np.zeros((width + 1, n))
-            for offset in range(width + 1):
-                band[width - offset, offset:] = np.diag(scaled, offset)
-            squared, vectors = scipy.linalg.eig_banded(band)
-        else:
-            squared, vectors = scipy.linalg.eigh((scaled + scaled.T) / 2)
-        shapes = vectors * scale[:, None]
-    else:
-        squared, shapes = scipy.linalg.eigh(K, M)
-    return np.sqrt(squared), np.array(shapes)
-
-
-def _exact_mpf(value: sympy.Expr) -> Any:
-    """An exact sympy number as an mpmath mpf at the current precision."""
-    if value.is_Rational:
-        return mpmath.mpf(value.p) / value.q
-    return mpmath.mpf(sympy.N(value, mpmath.mp.dps + 5))
-
-
-def _fixed_point(value: sympy.Expr, shift: int) -> int:
-    """round(value · 2^shift) for an exact sympy number."""
-    if value.is_Rational:
-        numerator, denominator = int(value.p) << shift, int(value.q)
-        return (2 * numerator + denominator) // (2 * denominator)
-    with workprec(shift + 64):
-        return int(mpmath.nint(mpmath.ldexp(_exact_mpf(value), shift)))
-
-
-class _Band(NamedTuple):
-    """A matrix by its nonzero diagonals: ``offset -> (entries, shift)``, the entries an int (a constant
-    diagonal) or an object column of ints, equal to the exact entries times 2^shift (shift 0: exact integers)."""
-
-    diagonals: dict[int, tuple[Any, int]]
-
-    @classmethod
-    def of(cls, exact: sympy.ImmutableMatrix, bits: int) -> "_Band":
-        by_offset: dict[int, dict[int, sympy.Expr]] = {}
-        for (row, col), value in exact.todok().items():
-            by_offset.setdefault(col - row, {})[row] = value
-        n = exact.rows
-        nonzero = [abs(float(value)) for entries in by_offset.values() for value in entries.values()]
-        # non-integer entries as fixed point, with room for the smallest of them relative to the largest
-        shift = bits + 64 + (int(np.ceil(np.log2(max(nonzero) / min(nonzero)))) if nonzero and min(nonzero) > 0 else 0)
-        diagonals: dict[int, tuple[Any, int]] = {}
-        for offset, entries in by_offset.items():
-            values = [entries.get(row - min(offset, 0), sympy.S.Zero) for row in range(n - abs(offset))]
-            exact = all(value.is_Integer for value in values)
-            scale = 0 if exact else shift
-            if all(value == values[0] for value in values):  # a constant diagonal: one int
-                diagonals[offset] = (int(values[0]) if exact else _fixed_point(values[0], scale), scale)
-            else:
-                diagonals[offset] = (np.array([int(v) if exact else _fixed_point(v, scale) for v in values], dtype=object)[:, None], scale)
-        return cls(diagonals)
-
-    @property
-    def identity(self) -> bool:
-        entries, shift = self.diagonals.get(0, (0, 0))
-        return set(self.diagonals) == {0} and isinstance(entries, int) and entries == 1 and not shift
-
-    def times(self, Y: np.ndarray) -> np.ndarray:
-        """``A @ Y`` for an object matrix of ints Y (rounded down where an entry is fixed point)."""
-        result = None
-        for offset in sorted(self.diagonals, key=lambda d: d != 0):
-            entries, shift = self.diagonals[offset]
-            if offset == 0:
-                source, target = Y, slice(None)
-            elif offset > 0:  # row i takes Y[i + offset]
-                source, target = Y[offset:], slice(None, -offset)
-            else:
-                source, target = Y[:offset], slice(-offset, None)
-            constant = isinstance(entries, int)
-            negate = constant and entries == -1 and not shift
-            if negate or (constant and entries == 1 and not shift):
-                term = source
-            else:
-                term = source * entries
-                if shift:
-                    term = term >> shift
-            if result is None:
-                result = np.zeros(Y.shape, dtype=object)
-            if negate:
-                result[target] -= term
-            else:
-                result[target] += term
-        return np.zeros(Y.shape, dtype=object) if result is None else result
-
-
-class _RefinedModes(NamedTuple):
-    """Mode shapes to high precision as fixed-point ints: column k of ``X`` over ``sqrt(norms[k])`` is φ_k
-    (``norms[k] = x_kᵀ M x_k`` in the same units); ``theta[k] = numerators[k] / norms[k]`` is λ_k²."""
-
-    X: np.ndarray
-    norms: list[int]
-    numerators: list[int]
-    bits: int
-
-    def frequencies(self) -> list[Any]:
-        """λ_k as mpf at the current mpmath precision."""
-        return [mpmath.sqrt(mpmath.mpf(numerator) / norm) for numerator, norm in zip(self.numerators, self.norms)]
-
-    def projections(self, exact: sympy.ImmutableMatrix) -> list[list[Any]]:
-        """``exact @ Φ`` (rows × modes) as mpf, for an exact matrix with few nonzero entries per row."""
-        rows: list[list[Any]] = []
-        shift = self.bits + 64
-        roots = [mpmath.sqrt(norm) for norm in self.norms]
-        entries: dict[int, list[tuple[int, sympy.Expr]]] = {}
-        for (row, col), value in exact.todok().items():
-            entries.setdefault(row, []).append((col, value))
-        for row in range(exact.rows):
-            total = np.zeros(self.X.shape[1], dtype=object)
-            scaled = False
-            for col, value in entries.get(row, []):
-                if value.is_Integer:
-                    total = total + self.X[col] * (int(value) << shift)
-                else:
-                    total = total + self.X[col] * _fixed_point(value, shift)
-                scaled = True
-            rows.append([mpmath.ldexp(mpmath.mpf(int(v)), -shift) / root if scaled else mpmath.mpf(0) for v, root in zip(total, roots)])
-        return rows
-
-
-def _refined_modes(system: "UnilateralSystem", digits: int) -> _RefinedModes | None:
-    """The float modes of :meth:`UnilateralSystem.modes` refined to ``digits`` digits (see ``modal_coupling``).
-
-    Fixed-point arithmetic on Python ints (X = ints · 2^-p): the residual of every mode is formed exactly
-    from the band of K and M (integer entries exactly, others to 2^-(p+64)), rounded to float64 and
-    projected on the float modes.  None when a relative gap between the θ_k is below 1e-9 or the sweeps
-    do not converge (the caller then decomposes densely in mpmath).
-    """
-    frequencies, shapes = system.modes()
-    theta_float = frequencies**2
-    n = system.n_dof
-    largest = float(theta_float[-1])
-    gaps = theta_float[:, None] - theta_float[None, :]
-    np.fill_diagonal(gaps, np.inf)
-    smallest_gap = float(np.min(np.abs(gaps))) if n > 1 else largest
-    if smallest_gap < 1e-9 * largest:
-        return None
-    conditioning = np.log2(largest / smallest_gap)
-    gain = 52 - conditioning - 4  # bits gained per sweep
-    if gain < 4:
-        return None
-    target = int(np.ceil(digits * np.log2(10))) + 4
-    magnitude = float(np.max(np.abs(shapes)))
-    # guard bits: the θ_k are accurate to 2^-p absolutely (the smallest one relatively: + log2(1/θ_1)), the
-    # shapes to 2^-p relative to their largest entry, and a sweep's residual loses log2(θ_max/gap)
-    bits = target + int(np.ceil(max(0.0, np.log2(max(1.0, largest) / float(theta_float[0]))) + conditioning)) + 16
-    p = bits + max(0, int(np.ceil(np.log2(max(1.0, magnitude) / min(np.max(np.abs(shapes), axis=0))))))
-    stiffness = _Band.of(system.K_exact, p)
-    mass = _Band.of(system.M_exact, p)
-    start = 62 - int(np.ceil(np.log2(magnitude)))
-    X = np.rint(np.ldexp(shapes, start)).astype(np.int64).astype(object) << (p - start)
-    theta = np.array([int(v) for v in np.rint(np.ldexp(theta_float, 52 - int(np.ceil(np.log2(largest)))))], dtype=object)
-    theta = theta << (p - 52 + int(np.ceil(np.log2(largest))))
-    for _ in range(int(np.ceil((target - 40) / gain)) + 3):
-        KX = stiffness.times(X)
-        MX = X if mass.identity else mass.times(X)
-        residual = _to_float(KX - ((MX * theta[None, :]) >> p), p)
-        projections = shapes.T @ residual  # x̃_lᵀ r_k ≈ (θ_l − θ_k) δ_lk, and θ*_k − θ_k on the diagonal
-        update = np.diag(projections)
-        theta = theta + _to_fixed(update, p)
-        correction = shapes @ (-projections / gaps)
-        X = X + _to_fixed(correction, p)
-        if np.max(np.abs(correction)) <= 2.0**-target * magnitude:
-            break
-    else:
-        return None
-    KX = stiffness.times(X)
-    MX = X if mass.identity else mass.times(X)
-    norms = [int(v) for v in (X * MX).sum(axis=0)]
-    numerators = [int(v) for v in (X * KX).sum(axis=0)]  # Rayleigh quotients: error ~ (shape error)²
-    return _RefinedModes(X, norms, numerators, bits)
-
-
-def _to_float(values: np.ndarray, p: int) -> np.ndarray:
-    """values · 2^-p as floats, for an object array of ints (shifted first where they could overflow a float)."""
-    if p > 900:
-        return np.ldexp((values >> (p - 900)).astype(float), -900)
-    return np.ldexp(values.astype(float), -p)
-
-
-def _to_fixed(values: np.ndarray, p: int) -> np.ndarray:
-    """round(values · 2^p) as an object array of ints, for floats of any size (62 significant bits kept)."""
-    largest = float(np.max(np.abs(values))) if values.size else 0.0
-    if largest == 0.0:
-        return np.zeros(values.shape, dtype=object)
-    exponent = 61 - int(np.ceil(np.log2(largest)))
-    scaled = np.rint(np.ldexp(values, min(exponent, p))).astype(np.int64).astype(object)
-    return scaled << (p - exponent) if exponent < p else scaled
-
-
-def _dense_mpmath_modes(system: "UnilateralSystem", digits: int) -> tuple[list[Any], list[list[Any]]]:
-    """Dense mpmath decomposition (O(N³) in multiprecision): the fallback for near-repeated frequencies."""
-    with workdps(digits + 10):
-        mass = mpmath.matrix([[_exact_mpf(v) for v in row] for row in system.M_exact.tolist()])
-        stiffness = mpmath.matrix([[_exact_mpf(v) for v in row] for row in system.K_exact.tolist()])
-        inverse_lower = mpmath.inverse(mpmath.cholesky(mass))
-        symmetric = inverse_lower * stiffness * inverse_lower.T
-        eigenvalues, eigenvectors = mpmath.eigsy((symmetric + symmetric.T) / 2)
-        shapes_matrix = inverse_lower.T * eigenvectors
-        reference = system.modes().shapes
-        frequencies, shapes = [], []
-        for position, index in enumerate(sorted(range(len(eigenvalues)), key=lambda i: eigenvalues[i])):
-            column = [shapes_matrix[row, index] for row in range(system.n_dof)]
-            # the sign of the float mode (modes()), so that both agree
-            sign = 1 if sum(float(value) * reference[row, position] for row, value in enumerate(column)) >= 0 else -1
-            frequencies.append(mpmath.sqrt(eigenvalues[index]))
-            shapes.append([sign * value for value in column])
-    with workdps(digits):
-        return [+value for value in frequencies], [[+value for value in column] for column in shapes]
 
 
 @locked
