@@ -55,6 +55,8 @@ __all__ = ["Arclength", "Attempt", "Stepper", "drive", "locate_kind", "step_fact
 
 #: the special points every branch is searched for, in the order they are reported
 KINDS = ("fold", "branch-point", "period-doubling", "neimark-sacker")
+#: the kinds whose test functions read the Floquet multipliers
+_MULTIPLIER_KINDS = ("period-doubling", "neimark-sacker")
 
 
 # --------------------------------------------------------------------------- #
@@ -329,6 +331,18 @@ class Arclength(Stepper):
     def land(self, value: float, guess: np.ndarray) -> tuple[Any, int, str]:
         """(the point at λ = value solved from the guess of z or None, Newton iterations, message)."""
 
+    def unknowns_of(self, point: Any, value: float) -> np.ndarray:
+        """The unknowns w = (z, λ) of a point."""
+        raise NotImplementedError
+
+    def check_value(self, value: float, iterations: int) -> Attempt | None:
+        """A rejection of a corrected λ before anything else (e.g. behind start), else None."""
+        return None
+
+    def landing_failed(self, iterations: int, target: float, message: str) -> Attempt:
+        """The attempt when the solve exactly at the end of the range failed (default: the branch ends)."""
+        return Attempt(iterations, target, end=f"the last point at {self.label} = {target:.8g} failed: {message}")
+
     def boundary(self, value: float) -> float | None:
         """The end of the range crossed by a step to λ = value (it lands there), else None."""
         return self.stop if self.direction * (value - self.stop) >= 0 else None
@@ -371,6 +385,19 @@ class Arclength(Stepper):
         return newton(augmented, base + sigma * unit * scales, scales, tol=self.tol,
                       max_iterations=self.max_iterations, step_tol=self.step_tol)
 
+    #: the orientation of the first tangent (scaled variables); None: towards stop
+    hint: np.ndarray | None = None
+
+    def begin(self, first: Any, value: float) -> str | None:
+        return self.start_at(self.unknowns_of(first, value), first, self.hint)
+
+    def tests_at(self, w: np.ndarray, outcome: NewtonOutcome, point: Any, unit: np.ndarray,
+                 scales: np.ndarray) -> dict[str, float]:
+        """The test functions at an accepted point reached without them (a jump's landing)."""
+        inner = outcome.last.data
+        return bifurcation_tests(self.multipliers(point, inner), unit, inner.jacobian * scales[None, :],
+                                 conservative=self.conservative)
+
     def start_at(self, w: np.ndarray, point: Any, hint: np.ndarray | None = None) -> str | None:
         """Set the branch's first point w (its tangent oriented along ``hint`` or towards stop)."""
         evaluation = self.evaluate(w)
@@ -379,7 +406,7 @@ class Arclength(Stepper):
         self.w, self.scales, self.last = w, self.scales_of(w, evaluation), point
         self.tangent = tangent(evaluation.jacobian, self.scales, hint, self.direction)
         self.tests = bifurcation_tests(self.multipliers(point, evaluation), self.tangent,
-                                    evaluation.jacobian * self.scales[None, :], conservative=self.conservative)
+                                       evaluation.jacobian * self.scales[None, :], conservative=self.conservative)
         return None
 
     def advance(self, points: list[Any], values: list[float]) -> Attempt:
@@ -391,6 +418,9 @@ class Arclength(Stepper):
         candidate = outcome.unknowns
         value = float(candidate[-1])
         inner = outcome.last.data
+        early = self.check_value(value, iterations)
+        if early is not None:
+            return early
         target = self.boundary(value)
         if target is not None:
             return self.finish_at(target, w, candidate, outcome, h, iterations, values)
@@ -402,18 +432,21 @@ class Arclength(Stepper):
         previous /= np.linalg.norm(previous)
         new_tangent = tangent(inner.jacobian, new_scales, previous, self.direction)
         turn = float(new_tangent @ previous)
+        self.spent = (iterations, 0)
         screened = self.screen(point, value, values, new_tangent, new_scales, turn, iterations)
         if screened is not None:
             return screened
+        iterations, rejected = self.spent
         if turn < self.max_turn and h > self.h_min and self.turn_counts(point):
             return Attempt(iterations, value, reason=f"the tangent turned too much (cos = {turn:.3f})")
         new_tests = bifurcation_tests(self.multipliers(point, inner), new_tangent,
-                                   inner.jacobian * new_scales[None, :], conservative=self.conservative)
-        self.pending = (candidate, new_scales, new_tangent, outcome, point, new_tests, len(values) - 1)
+                                      inner.jacobian * new_scales[None, :], conservative=self.conservative)
+        self.pending = (candidate, new_scales, new_tangent, outcome, point, new_tests, len(values) - 1,
+                        abs(value - values[-1]))
         complete = self.complete_at(point, candidate, values)
         if complete:
-            return Attempt(iterations, value, point, reason=complete, complete=True)
-        return Attempt(iterations, value, point)
+            return Attempt(iterations, value, point, reason=complete, complete=True, rejected=rejected)
+        return Attempt(iterations, value, point, rejected=rejected)
 
     def finish_at(self, target: float, w: np.ndarray, candidate: np.ndarray, outcome: NewtonOutcome, h: float,
                   iterations: int, values: list[float]) -> Attempt:
@@ -434,17 +467,17 @@ class Arclength(Stepper):
         point, more, message = self.land(target, guess)
         iterations += more
         if point is None:
-            return Attempt(iterations, target, end=self.landing_failed(target, message))
+            return self.landing_failed(iterations, target, message)
         return Attempt(iterations, target, point, complete=True)
 
-    def landing_failed(self, target: float, message: str) -> str:
-        return f"the last point at {self.label} = {target:.8g} failed: {message}"
-
     def search(self, before: dict[str, float], after: dict[str, float], h: float, index: int, *,
-               within: float | None = None) -> None:
-        """Locate the special points whose test function changes sign over the step of length h from self.w."""
+               within: float | None = None, smooth: bool = True) -> None:
+        """Locate the special points whose test function changes sign over the step of length h from self.w
+        (only the fold where the residual is not smooth over the step: the other tests may jump there)."""
         turned_back = before["fold"] * after["fold"] < 0
         for kind in changes(before, after, turned_back=turned_back):
+            if not smooth and kind != "fold":
+                continue
             found = self.locate(kind, before[kind], after[kind], h)
             if found is None:
                 continue
@@ -465,7 +498,7 @@ class Arclength(Stepper):
                 return None
             inner = outcome.last.data
             point = None
-            if self.multipliers_need_point:
+            if self.multipliers_need_point and kind in _MULTIPLIER_KINDS:  # the others need no verified orbit
                 point, _ = self.verify(outcome.unknowns, outcome)
                 if point is None:
                     return None
@@ -479,7 +512,7 @@ class Arclength(Stepper):
     def accept(self, attempt: Attempt) -> None:
         if attempt.complete and attempt.point is not self.pending_point():
             return  # landed at the end of the range: its special points were searched by finish_at
-        candidate, scales, unit, outcome, point, tests, index = self.pending
+        candidate, scales, unit, outcome, point, tests, index, _ = self.pending
         self.search(self.tests, tests, self.step, index)
         if attempt.complete:
             return

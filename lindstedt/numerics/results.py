@@ -26,8 +26,9 @@ from typing import Any
 
 import numpy as np
 
-from ..export.display import format_number, format_vector, html_grid, html_table, labelled_repr
-from ..export.json import JsonExport, finite_float, to_jsonable
+from ..render.display import format_number, format_vector, html_grid, html_table, labelled_repr
+from ..render.json import JsonExport, finite_float, to_jsonable
+from .forced_results import Bifurcation
 
 __all__ = ["ContinuationProgress", "NNMBranch", "NNMResult", "to_dataframe"]
 
@@ -347,6 +348,15 @@ class NNMBranch(JsonExport):
         continuous arc; ``stop_reason`` says what each jump crossed.  Contact
         changes (``contact_changes``, e.g. the contact onset where the
         backbone turns steep) are followed, not jumped.
+    bifurcations : tuple of Bifurcation
+        The special points located on the branch (method "arclength") by the
+        same test functions as on forced branches
+        (:mod:`lindstedt.numerics.arclength`): folds, branch points and
+        period doublings (a non-trivial Floquet multiplier through −1); the
+        Neimark–Sacker test does not apply to these conservative orbits.  Not
+        searched across a contact change or a jump, where the residual is not
+        smooth.  ``frequency`` is ω, ``amplitude`` ``|X0|``, ``state``
+        ``(X0, X1)`` and ``forcing_scale`` the parameter value there.
 
     JSON schema ``lindstedt.nnm-branch/1`` (:meth:`to_json`; every point as
     its ``lindstedt.nnm-numeric/1`` dictionary).
@@ -369,6 +379,7 @@ class NNMBranch(JsonExport):
     wall_time: float
     system: Any = field(default=None, repr=False, compare=False)  # the UnilateralSystem it was computed for
     jumps: tuple[int, ...] = ()
+    bifurcations: tuple[Bifurcation, ...] = ()
 
     def __len__(self) -> int:
         return len(self.points)
@@ -416,6 +427,7 @@ class NNMBranch(JsonExport):
             ("stability_changes", indices(self.stability_changes)),
             ("contact_changes", indices(self.contact_changes)),
             ("jumps", indices(self.jumps)),
+            ("bifurcations", ", ".join(f"{b.kind} at {b.forcing_scale:.6g}" for b in self.bifurcations) or "none"),
             ("flow_evaluations", str(self.flow_evaluations)),
             ("newton_iterations", str(self.newton_iterations)),
             ("rejected_steps", str(self.rejected_steps)),

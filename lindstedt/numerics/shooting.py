@@ -84,7 +84,6 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -92,8 +91,8 @@ import numpy as np
 
 from .._errors import ConvergenceError, ProblemError
 from .._precision import LOCK
-from ..limits import checkpoint
 from .flow import ExactFlow
+from .newton import Evaluation, newton
 from ..problems.parsing import parse_float
 from ..problems.system import UnilateralSystem
 from .results import NNMResult, _repetitions
@@ -103,8 +102,6 @@ __all__ = ["NNMShooting", "nnm_energy"]
 
 _TWO_PI = 2.0 * math.pi
 _FORMULATIONS = ("symmetric", "full")
-#: relative σ_min/σ_max below which a Newton matrix is declared singular
-_SINGULAR_RATIO = 1e-13
 #: a scaled Newton step this small ends the iteration (the caller verifies the final state)
 _STEP_TOL = 1e-7
 
@@ -427,6 +424,13 @@ class NNMShooting:
         out["d_level"] = d_level
         return out
 
+    def _evaluation(self, unknowns: np.ndarray, epsilon: float, amplitude: _Amplitude | None) -> Evaluation:
+        """:meth:`evaluate` for the core's Newton."""
+        out = self.evaluate(unknowns, epsilon, amplitude=amplitude)
+        if not out["success"]:
+            return Evaluation(False, out["message"])
+        return Evaluation(True, "", out["residual"], out["jacobian"], data=out)
+
     def residual(self, unknowns: Any, epsilon: float) -> np.ndarray:
         """Scaled residual vector (raises ConvergenceError if the flow fails)."""
         out = self.evaluate(unknowns, epsilon, jacobian=False)
@@ -651,8 +655,8 @@ class NNMShooting:
                        min_mode_share: float | None) -> NNMResult:
         x_guess, _, period_guess = self.split(z0)
         self.set_scales(epsilon, x_guess if np.max(np.abs(x_guess)) > 0 else None, period_guess, amplitude)
-        outcome = _newton(lambda z: self.evaluate(z, epsilon, amplitude=amplitude), z0, self.column_scales(), tol=tol,
-                          max_iterations=max_iterations)
+        outcome = newton(lambda z: self._evaluation(z, epsilon, amplitude), z0, self.column_scales(), tol=tol,
+                         max_iterations=max_iterations, step_tol=_STEP_TOL)
         if not outcome.success:
             return self._failure(epsilon, outcome.message, outcome.iterations, x0=self.split(outcome.unknowns)[0])
         return self.verify(outcome.unknowns, epsilon, verify_tol=verify_tol, stability_tol=stability_tol,
@@ -662,100 +666,6 @@ class NNMShooting:
 # --------------------------------------------------------------------------- #
 # Newton
 # --------------------------------------------------------------------------- #
-@dataclass
-class _NewtonOutcome:
-    success: bool
-    message: str
-    unknowns: np.ndarray
-    iterations: int
-    last: dict[str, Any] | None = None
-    #: scaled sizes max|Δ/columns| of the full Newton steps, in order (their ratios are the contraction)
-    steps: tuple[float, ...] = ()
-
-
-def _scaled_solve(matrix: np.ndarray, rhs: np.ndarray, columns: np.ndarray) -> tuple[np.ndarray | None, float]:
-    """Least-squares solve of matrix·Δ = rhs with column scaling; (Δ, σ_min/σ_max)."""
-    scaled = matrix * columns[None, :]
-    if not np.all(np.isfinite(scaled)):
-        return None, 0.0
-    singular_values = np.linalg.svd(scaled, compute_uv=False)
-    ratio = float(singular_values[-1] / singular_values[0]) if singular_values[0] > 0 else 0.0
-    if ratio < _SINGULAR_RATIO:
-        return None, ratio
-    step = np.linalg.lstsq(scaled, rhs, rcond=None)[0]
-    return step * columns, ratio
-
-
-def _newton(
-    evaluate: Callable[[np.ndarray], dict[str, Any]],
-    unknowns: np.ndarray,
-    columns: np.ndarray,
-    *,
-    tol: float,
-    max_iterations: int,
-    jacobian_key: str = "jacobian",
-    step_tol: float = _STEP_TOL,
-    max_backtracks: int = 5,
-) -> _NewtonOutcome:
-    """Damped (Gauss–)Newton on the scaled residual.
-
-    Stops when the residual is ≤ tol, or when a full Newton step is ≤ step_tol
-    (scaled): quadratic convergence then puts the residual of ``z + Δ`` far
-    below tol, and the caller verifies that final state with a full-period
-    flow, so it is not evaluated here (one flow saved per solve).  ``last`` is
-    the last evaluation (its Jacobian serves for the continuation tangent).
-    """
-    z = np.array(unknowns, dtype=float)
-    current = evaluate(z)
-    if not current["success"]:
-        return _NewtonOutcome(False, current["message"], z, 0, None)
-    norm = float(np.max(np.abs(current["residual"])))
-    sizes: list[float] = []
-    for iteration in range(1, max_iterations + 1):
-        checkpoint("Newton iteration", iteration, max_iterations)
-        step, ratio = _scaled_solve(current[jacobian_key], -current["residual"], columns)
-        if norm <= tol:
-            # converged: the Newton step already computed polishes the last digits (quadratic convergence), as a
-            # step ≤ step_tol below; the caller verifies the final state
-            polish = step is not None and float(np.max(np.abs(step / columns))) <= step_tol
-            return _NewtonOutcome(True, f"residual {norm:.1e}", z + step if polish else z, iteration - 1, current,
-                                  tuple(sizes))
-        if step is None:
-            return _NewtonOutcome(
-                False,
-                f"singular Jacobian (σ_min/σ_max = {ratio:.1e}) at iteration {iteration}, residual {norm:.1e}: a fold "
-                "of the branch in this parameter, a bifurcation (internal resonance λ_k/ω ∈ ℤ) or a degenerate "
-                "amplitude — continue the branch with pseudo-arclength (continue_nnm) or change the parameter",
-                z, iteration, current, tuple(sizes),
-            )
-        size = float(np.max(np.abs(step / columns)))
-        sizes.append(size)
-        if size <= step_tol:
-            return _NewtonOutcome(True, f"residual {norm:.1e}, last step {size:.1e}", z + step, iteration, current,
-                                  tuple(sizes))
-        damping = 1.0
-        for _ in range(max_backtracks + 1):
-            trial = z + damping * step
-            candidate = evaluate(trial)
-            if candidate["success"]:
-                trial_norm = float(np.max(np.abs(candidate["residual"])))
-                if trial_norm < norm or trial_norm <= tol:
-                    break
-            damping *= 0.5
-        else:
-            return _NewtonOutcome(
-                False,
-                f"no convergence: no Newton step decreased the residual at iteration {iteration} "
-                f"(residual {norm:.1e}; last: {candidate.get('message') or 'larger residual'})",
-                z, iteration, current, tuple(sizes),
-            )
-        z, current, norm = trial, candidate, trial_norm
-    if norm <= tol:
-        return _NewtonOutcome(True, f"residual {norm:.1e}", z, max_iterations, current, tuple(sizes))
-    return _NewtonOutcome(False, f"no convergence in {max_iterations} Newton iterations (residual {norm:.1e})", z,
-                          max_iterations, current, tuple(sizes))
-
-
 class _ExpansionPredictor:
     """Newton guesses from the strained-coordinates NNM expansion (:func:`lindstedt.nnm`, order 2).
 
