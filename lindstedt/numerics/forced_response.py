@@ -89,6 +89,9 @@ class _ForcedBranch(Arclength):
         self.gap: np.ndarray | None = None
         self.landed: float | None = None
 
+    def unknowns_of(self, point: ForcedOrbit, value: float) -> np.ndarray:
+        return np.r_[point.state, value]
+
     def split(self, w: np.ndarray) -> tuple[np.ndarray, float, float]:
         lam = float(w[-1])
         return (w[:-1], lam, self.fixed) if self.parameter == "frequency" else (w[:-1], self.fixed, lam)
@@ -373,9 +376,6 @@ def frequency_response(flow: PeriodMap | ForcedOscillator | ForcedSystem, start:
     D = _scales(flow, first, omega, abs(stop - start), amplitude_scale)
     stepper = _ForcedBranch(flow, parameter, fixed, k, D, options, start=start, stop=stop,
                             bounds=(min(start, stop), max(start, stop)), rejoin=False, direction=stop - start)
-    failure = stepper.start_at(np.r_[first.state, start], first)
-    if failure:
-        return stepper.assemble([first], [start], failure, False, 0, first.newton_iterations, started)
     notify = None if callback is None else (lambda index, value, orbit: callback(index, orbit) and False)
     return drive(stepper, first, start, options["max_points"], iterations=first.newton_iterations, notify=notify,
                  started=started)
@@ -458,10 +458,7 @@ def switch_period_doubling(response: FrequencyResponse, index: int = 0, *, stop:
     first = replace(first, newton_iterations=outcome.iterations, flow_evaluations=0, steps=0, evaluations=0)
     stepper.first_message = f"switched at the period doubling {parameter} = {lam_star:.10g}"
     lam1 = float(w1[-1])
-    stepper.direction = 1.0 if lam1 >= lam_star else -1.0
-    failure = stepper.start_at(w1, first, hint=t0)
-    if failure:
-        return stepper.assemble([first], [lam1], failure, False, 0, outcome.iterations, started)
+    stepper.direction, stepper.hint = (1.0 if lam1 >= lam_star else -1.0), t0
     return drive(stepper, first, lam1, merged["max_points"], iterations=outcome.iterations, started=started)
 
 
