@@ -243,7 +243,8 @@ def locate_kind(kind: str, f0: float, f1: float, h: float, probe: Callable[[floa
     """Regula falsi (Illinois) on a test function along the arclength σ ∈ [0, h] of one step.
 
     ``probe(σ)`` corrects the predictor at σ and returns ``(test value, located data)``, None on failure.
-    Returns the data and the test value at the last probe (σ bracketed to ``tol``), or None.
+    Returns the data and the test value at the last probe, an end of a bracket of the zero at most ``tol`` wide
+    (or after ``max_iterations`` probes), or None.
     """
     a, fa, b, fb = 0.0, f0, h, f1
     found = None
@@ -256,7 +257,7 @@ def locate_kind(kind: str, f0: float, f1: float, h: float, probe: Callable[[floa
             return None
         fc, data = probed
         found = (data, fc)
-        if fc == 0 or abs(b - a) <= tol:
+        if fc == 0:
             break
         if fc * fb < 0:
             a, fa = b, fb
@@ -371,8 +372,13 @@ class Arclength(Stepper):
         """The record of a special point located at w (its point if verified, its evaluation), None to drop it."""
 
     # ------------------------------------------------------------ machinery
-    def corrector(self, base: np.ndarray, scales: np.ndarray, unit: np.ndarray, sigma: float) -> NewtonOutcome:
-        """Newton on ``[G(w); tᵀ(w − base)/D − σ] = 0`` from the predictor ``base + σ D t``."""
+    def corrector(self, base: np.ndarray, scales: np.ndarray, unit: np.ndarray, sigma: float, *,
+                  locating: bool = False) -> NewtonOutcome:
+        """Newton on ``[G(w); tᵀ(w − base)/D − σ] = 0`` from the predictor ``base + σ D t``.
+
+        ``locating``: a probe of a special point — converged on the residual alone (the last evaluation, whose
+        test functions are read, is then at the returned point) and through a branch point, where the augmented
+        Jacobian is singular."""
 
         def augmented(candidate: np.ndarray) -> Evaluation:
             inner = self.evaluate(candidate)
@@ -383,7 +389,8 @@ class Arclength(Stepper):
                               np.vstack([inner.jacobian, unit / scales]), inner.step_bound, inner, inner.singular)
 
         return newton(augmented, base + sigma * unit * scales, scales, tol=self.tol,
-                      max_iterations=self.max_iterations, step_tol=self.step_tol)
+                      max_iterations=self.max_iterations, step_tol=None if locating else self.step_tol,
+                      allow_singular=locating)
 
     #: the orientation of the first tangent (scaled variables); None: towards stop
     hint: np.ndarray | None = None
@@ -493,7 +500,7 @@ class Arclength(Stepper):
         base, scales, unit = self.w, self.scales, self.tangent
 
         def probe(sigma: float) -> tuple[float, Any] | None:
-            outcome = self.corrector(base, scales, unit, sigma)
+            outcome = self.corrector(base, scales, unit, sigma, locating=True)
             if not outcome.success:
                 return None
             inner = outcome.last.data

@@ -75,14 +75,16 @@ class NewtonOutcome:
     steps: tuple[float, ...] = ()
 
 
-def scaled_solve(matrix: np.ndarray, rhs: np.ndarray, columns: np.ndarray) -> tuple[np.ndarray | None, float]:
-    """Least-squares solve of ``matrix · Δ = rhs`` with column scaling; ``(Δ, σ_min/σ_max)``, Δ None if singular."""
+def scaled_solve(matrix: np.ndarray, rhs: np.ndarray, columns: np.ndarray,
+                 allow_singular: bool = False) -> tuple[np.ndarray | None, float]:
+    """Least-squares solve of ``matrix · Δ = rhs`` with column scaling; ``(Δ, σ_min/σ_max)``, Δ None if singular
+    (unless ``allow_singular``: then the minimum-norm step, which has no component along the null space)."""
     scaled = matrix * columns[None, :]
     if not np.all(np.isfinite(scaled)):
         return None, 0.0
     singular_values = np.linalg.svd(scaled, compute_uv=False)
     ratio = float(singular_values[-1] / singular_values[0]) if singular_values[0] > 0 else 0.0
-    if ratio < SINGULAR_RATIO:
+    if ratio < SINGULAR_RATIO and not allow_singular:
         return None, ratio
     step = np.linalg.lstsq(scaled, rhs, rcond=None)[0]
     return step * columns, ratio
@@ -98,6 +100,7 @@ def newton(
     step_tol: float | None = None,
     max_backtracks: int = 5,
     accept_last: bool = False,
+    allow_singular: bool = False,
     first: Evaluation | None = None,
 ) -> NewtonOutcome:
     """Damped (Gauss–)Newton on a scaled residual; see the module docstring.
@@ -116,6 +119,9 @@ def newton(
         Halvings of a step that does not decrease the residual.
     accept_last : bool
         Keep the last halving even when the residual did not decrease (else the solve fails).
+    allow_singular : bool
+        Take the minimum-norm step where the scaled Jacobian is singular (solving on a singular point on
+        purpose: a branch point being located), instead of failing.
     first : Evaluation, optional
         The evaluation at ``unknowns`` when the caller already has it.
 
@@ -134,7 +140,7 @@ def newton(
         if not math.isfinite(norm):
             return NewtonOutcome(False, f"non-finite residual at iteration {iteration - 1}", z, iteration - 1, current,
                                  tuple(sizes))
-        step, ratio = scaled_solve(current.jacobian, -current.residual, columns)
+        step, ratio = scaled_solve(current.jacobian, -current.residual, columns, allow_singular)
         if norm <= tol:
             # converged: the Newton step already computed polishes the last digits (quadratic convergence)
             polish = step is not None and step_tol is not None and float(np.max(np.abs(step / columns))) <= step_tol

@@ -636,12 +636,12 @@ class NNMShooting:
         """
         options = dict(tol=tol, max_iterations=max_iterations, verify_tol=verify_tol, stability_tol=stability_tol,
                        min_mode_share=min_mode_share)
-        first = self._newton_verify(z0, epsilon, amplitude, **options)
+        first = self._solve_and_verify(z0, epsilon, amplitude, **options)
         m = first.minimal_periods
         if first.success or m == 1:
             return first
         guess = self._join(first.release_position, first.release_velocity, first.period / m)
-        result = self._newton_verify(guess, epsilon, amplitude, **options)
+        result = self._solve_and_verify(guess, epsilon, amplitude, **options)
         iterations = first.newton_iterations + result.newton_iterations
         if result.success:
             return replace(result, newton_iterations=iterations, message=(
@@ -650,7 +650,7 @@ class NNMShooting:
         return replace(result, newton_iterations=iterations, message=(
             f"{first.message}; re-solving at T/{m} failed: {result.message}"))
 
-    def _newton_verify(self, z0: np.ndarray, epsilon: float, amplitude: _Amplitude | None, *, tol: float,
+    def _solve_and_verify(self, z0: np.ndarray, epsilon: float, amplitude: _Amplitude | None, *, tol: float,
                        max_iterations: int, verify_tol: float, stability_tol: float,
                        min_mode_share: float | None) -> NNMResult:
         x_guess, _, period_guess = self.split(z0)
