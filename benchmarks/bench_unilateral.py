@@ -662,7 +662,7 @@ def run(quick: bool = False) -> str:
       f"{codegen['numpy_vs_c_argmax_kappa']:.9f}.")
     w("")
     w("Accuracy at sample κ (doubles; reference at the exact value of the double). The generated code evaluates "
-      "exact series in the angle (see `lindstedt.export.stable`); the closed form in 30-digit mpmath and the "
+      "exact series in the angle (see `lindstedt.compiled.stable_series`); the closed form in 30-digit mpmath and the "
       "`numeric=True` engine are shown for contrast:")
     w("")
     w("| κ | ω2 (reference) | generated NumPy rel. error | generated C rel. error | abs. error (C) | closed form, mpmath 30 digits | `numeric=True` (30 digits) |")

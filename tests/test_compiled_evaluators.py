@@ -1,7 +1,7 @@
 """Compiled evaluators: Expansion.frequency / displacement / velocity / frequency_coefficients.
 
 The evaluators read float parameter values through closed forms compiled once per expansion
-(:func:`lindstedt.export.stable.compile_family`), accepted only where their first-order rounding bound is
+(:func:`lindstedt.compiled.family.compile_family`), accepted only where their first-order rounding bound is
 at most 1e-13 of the value, with exact series in acos κ (one gap symbol) or the exact expression elsewhere.
 
 References are independent of that code: the exact sympy expressions (``omega_correction``,
@@ -26,7 +26,7 @@ import sympy
 
 import lindstedt
 from lindstedt import ExpansionValidityWarning, ParameterError, ProblemError
-from lindstedt.export.stable import compile_family
+from lindstedt.compiled.family import compile_family
 from lindstedt.results.accuracy import series_warning
 
 KAPPAS = [0.3, -0.7, 0.9, 1 - 1e-6, -1 + 1e-6]

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import lindstedt
-from lindstedt.export.display import jupyter_latex
+from lindstedt.render.display import jupyter_latex
 from lindstedt.numerics.results import NNMBranch
 
 

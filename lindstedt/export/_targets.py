@@ -2,7 +2,7 @@
 :func:`lindstedt.export.codegen.generate_code` beyond NumPy and C).
 
 The expressions — ω(ε), u(t; ε), or a gap coefficient ω_k(κ) by the stable series of
-:mod:`lindstedt.export.stable` — are printed by sympy's printer of each language; this module writes
+:mod:`lindstedt.compiled.stable_series` — are printed by sympy's printer of each language; this module writes
 only the scaffolding around them (function header, element loop, if/else over the series' patches).
 """
 
@@ -14,8 +14,8 @@ from typing import Any
 import sympy
 
 from .._errors import CodeGenerationError
-from ._names import _C_RESERVED, _PYTHON_RESERVED, _safe_names
-from .stable import Patch
+from ..compiled.names import _C_RESERVED, _PYTHON_RESERVED, _safe_names
+from ..compiled.stable_series import Patch
 
 # -- Octave/MATLAB, Julia, Fortran, Rust and JAX -------------------------------------------------------
 #
@@ -215,7 +215,7 @@ def _target_source(
 def _stable_target_source(
     language: str, name: str, epsilon: sympy.Symbol, x: sympy.Symbol, pieces: list, frequency: bool, accuracy: str
 ) -> str:
-    """The piecewise exact series of :mod:`lindstedt.export.stable` as if/else (where-chains for JAX)."""
+    """The piecewise exact series of :mod:`lindstedt.compiled.stable_series` as if/else (where-chains for JAX)."""
     statements: list[Any] = []
     targets = []
     for k, piece in pieces:

@@ -19,7 +19,7 @@ Two quantities can be generated for any :class:`~lindstedt.Expansion`:
 Accuracy.  When the expansion's one free symbol is a gap κ (f = (u − κ)_+, a0 = 1: ω_k is a closed form
 in κ, acos κ and sqrt(1 − κ²)), ``"omega<k>"`` and ``"frequency"`` are not printed from the closed form,
 which cancels catastrophically near κ = ±1 (ω_2 ∝ (1 − κ)^(5/2) from O(1) terms), but as piecewise exact
-series in acos κ (see :mod:`lindstedt.export.stable`): relative error ≤ 1e-13 for every κ in
+series in acos κ (see :mod:`lindstedt.compiled.stable_series`): relative error ≤ 1e-13 for every κ in
 (−1, 1).  :attr:`GeneratedCode.accuracy` states the guarantee, or its absence, for every generated function.
 
 Otherwise the expression is reduced by common-subexpression elimination (``sympy.cse``)
@@ -59,8 +59,8 @@ from sympy.printing.numpy import NumPyPrinter
 from .._errors import CodeGenerationError, ProblemError
 from .._precision import locked, locked_methods
 from ._targets import _TARGETS, _renaming, _stable_target_source, _target_source
-from ._stable_source import renamed, stable_c_source, stable_coefficient_cached, stable_numpy_source
-from .stable import SERIES_TARGET, StableCoefficient
+from ..compiled.stable_series import SERIES_TARGET, StableCoefficient
+from ..compiled.stable_source import renamed, stable_c_source, stable_coefficient_cached, stable_numpy_source
 
 __all__ = ["GeneratedCode", "generate_code"]
 
@@ -109,7 +109,7 @@ class GeneratedCode:
 
     def __repr__(self) -> str:
         """Labelled fields with the source cut (the whole source is ``.source``)."""
-        from .display import labelled_repr
+        from ..render.display import labelled_repr
 
         return labelled_repr("GeneratedCode", [
             ("language", repr(self.language)), ("quantity", repr(self.quantity)),

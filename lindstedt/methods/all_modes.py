@@ -29,7 +29,7 @@ import numpy as np
 
 from .._errors import ProblemError
 from .._precision import locked, locked_methods
-from ..export.json import JsonExport
+from ..render.json import JsonExport
 from ..problems.system import UnilateralSystem
 
 __all__ = ["AllModesFirstOrder", "all_modes_first_order"]
@@ -83,7 +83,7 @@ class AllModesFirstOrder(JsonExport):
         return np.array(self.lambdas) + epsilon * np.array([value for value, _ in self.corrections])
 
     def _display_rows(self) -> list[tuple[str, str, str, str, str]]:
-        from ..export.display import format_number
+        from ..render.display import format_number
 
         return [(str(k + 1), format_number(lam), format_number(amplitude), f"{format_number(value)} ± {format_number(error, 2)}", method)
                 for k, (lam, amplitude, (value, error), method) in enumerate(zip(self.lambdas, self.amplitudes, self.corrections, self.methods))]
@@ -98,7 +98,7 @@ class AllModesFirstOrder(JsonExport):
         >>> print(repr(result).splitlines()[1])
           mode 1: lambda=1, a=1, correction=0.25 ± 0, closed form (zero gaps)
         """
-        from ..export.display import shorten
+        from ..render.display import shorten
 
         head = f"AllModesFirstOrder(success={self.success}, polarised_mode={self.polarised_mode}, message={shorten(self.message, 120)!r},"
         lines = [f"  mode {k}: lambda={lam}, a={a}, correction={c}, {m}" for k, lam, a, c, m in self._display_rows()]
@@ -106,7 +106,7 @@ class AllModesFirstOrder(JsonExport):
 
     def _repr_html_(self) -> str:
         """Jupyter's rendering: one row per mode."""
-        from ..export.display import html_grid
+        from ..render.display import html_grid
 
         return html_grid("AllModesFirstOrder", ["mode", "λ_k", "a_k", "λ_k¹ ± error", "method"], self._display_rows(), note=self.message)
 

@@ -21,7 +21,7 @@ from ..problems.piecewise_linear import has_non_polynomial_law
 from ..engine.branches import BranchHierarchy
 from ..engine.contact import contact_normal_form
 from ..engine.smooth import MAX_ORDER, SmoothHierarchy, normal_form
-from ..export.stable import forget_families
+from ..compiled.family import forget_families
 from .._cost import expansion_estimate
 from ..limits import Estimate
 

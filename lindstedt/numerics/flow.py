@@ -75,8 +75,8 @@ import numpy as np
 
 from .._errors import ProblemError
 from .._precision import locked
-from ..export.display import format_number, format_vector, html_table, labelled_repr
-from ..export.json import JsonExport, exported_fields, to_jsonable
+from ..render.display import format_number, format_vector, html_table, labelled_repr
+from ..render.json import JsonExport, exported_fields, to_jsonable
 from ..problems.system import UnilateralSystem
 from .switching import _Bracket, _Counters, _earliest_switch, _first_exit_trig, _SearchFailure
 

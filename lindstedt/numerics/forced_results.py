@@ -27,8 +27,8 @@ from typing import Any
 import numpy as np
 
 from .._errors import LindstedtError, ProblemError
-from ..export.display import format_number, format_vector, html_grid, html_table, labelled_repr
-from ..export.json import JsonExport
+from ..render.display import format_number, format_vector, html_grid, html_table, labelled_repr
+from ..render.json import JsonExport
 
 __all__ = ["Bifurcation", "ForcedOrbit", "FrequencyResponse"]
 

@@ -2,7 +2,7 @@
 
 Each W_n is, piece by piece between the moving contact angles β_i + Σ_n η̂^n σ_{i,n}, a sum
 Σ c s^m trig(ν s); the coefficients of every order are one flat vector (from the compiled closed forms of
-:func:`lindstedt.export.stable.compile_family`, with a rounding bound), evaluated for arrays of t, ε and
+:func:`lindstedt.compiled.family.compile_family`, with a rounding bound), evaluated for arrays of t, ε and
 parameters at once.  Used by :class:`lindstedt.results.expansion.Expansion`.
 """
 
@@ -15,7 +15,7 @@ import numpy as np
 import sympy
 
 from ..engine.branches import FloatBranches
-from ..export.stable import compile_family
+from ..compiled.family import compile_family
 
 _WAVEFORM_TOLERANCE = 1e-13  # bound on |δu| / |a0| accepted from compiled waveform data
 

@@ -21,7 +21,7 @@ import numpy as np
 import sympy
 
 from .._errors import ParameterError
-from ..export.stable import compile_family
+from ..compiled.family import compile_family
 from ..problems.oscillator import Oscillator, check_names
 
 __all__ = ["DerivationAssumptions", "check_names", "shown_values"]

@@ -15,9 +15,9 @@ expressions in the amplitude ``A``, the detuning ``σ``, the phase ``γ`` and ``
 
 and evaluates them: :meth:`~FrequencyResponseCurve.amplitudes` (every steady amplitude at a forcing
 frequency), :meth:`~FrequencyResponseCurve.detuning`, :meth:`~FrequencyResponseCurve.frequency`,
-:meth:`~FrequencyResponseCurve.backbone`, :meth:`~FrequencyResponseCurve.stability`.  It exports
-itself through the one export layer: :meth:`~FrequencyResponseCurve.to_latex`, ``to_json()``
-(:class:`~lindstedt.export.json.JsonExport`) and ``_repr_latex_``; code for its closed forms is
+:meth:`~FrequencyResponseCurve.backbone`, :meth:`~FrequencyResponseCurve.stability`.  It shows
+itself through the one rendering layer: :meth:`~FrequencyResponseCurve.to_latex`, ``to_json()``
+(:class:`~lindstedt.render.json.JsonExport`) and ``_repr_latex_``; code for its closed forms is
 ``lindstedt.generate_code(curve, quantity, language)`` (the export layer reads the result, via
 :meth:`~FrequencyResponseCurve.code_form`).
 """
@@ -33,8 +33,8 @@ import sympy
 
 from .._errors import ParameterError, ProblemError
 from .._precision import locked_methods
-from ..export.display import jupyter_latex, labelled_repr, latex_text, shorten
-from ..export.json import JsonExport
+from ..render.display import jupyter_latex, labelled_repr, latex_text, shorten
+from ..render.json import JsonExport
 from ..problems.forced import ForcedOscillator, check_forcing_frequency
 from .expansion import EPSILON
 
@@ -543,7 +543,7 @@ class FrequencyResponseCurve(JsonExport):
         --------
         >>> from lindstedt.methods.multiple_scales import frequency_response_curve
         >>> print(frequency_response_curve("u**3", omega0=1, zeta="1/100", forcing=1).to_latex())  # doctest: +ELLIPSIS
-        % lindstedt: u'' + 2*(1/100)*1*u' + 1**2*u + eps*(u**3) = eps*1*cos(Omega*t); multiple scales, order 1
+        % lindstedt: u'' + u'/50 + u + eps*(u**3) = eps*cos(Omega*t); multiple scales, order 1
         \begin{align*}
         & \ddot u + 2\zeta\omega_0 \dot u + \omega_0^2 u + \varepsilon f(u) = \varepsilon F \cos \Omega t,\quad ...
         & f(u) = u^{3},\ \omega_0 = 1,\ \zeta = \frac{1}{100},\ F = 1 \\

@@ -17,8 +17,8 @@ import mpmath
 import numpy as np
 import sympy
 
-from ..export.json import finite_float
-from ..export.display import DIGITS, format_number, format_vector, jupyter_latex, labelled_repr
+from ..render.json import finite_float
+from ..render.display import DIGITS, format_number, format_vector, jupyter_latex, labelled_repr
 from ..engine.branches import BranchHierarchy, FloatBranches, fold
 from .accuracy import (
     ExpansionValidityWarning,

@@ -17,8 +17,8 @@ import sympy
 
 from .._errors import OrderError
 from ..engine.stretched import FloatArc
-from ..export.display import DIGITS, format_number, format_vector, jupyter_latex, labelled_repr
-from ..export.json import JsonExport
+from ..render.display import DIGITS, format_number, format_vector, jupyter_latex, labelled_repr
+from ..render.json import JsonExport
 from .._precision import locked_methods, workdps
 
 __all__ = ["STRETCHED_TIME", "StretchedArcSeries"]

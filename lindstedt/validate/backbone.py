@@ -24,7 +24,7 @@ import numpy as np
 
 from .._errors import ProblemError
 from .._sweep import sweep_map
-from ..export.json import JsonExport
+from ..render.json import JsonExport
 from ..problems.oscillator import Oscillator
 
 __all__ = ["Backbone", "backbone"]

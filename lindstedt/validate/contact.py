@@ -19,7 +19,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from .._errors import ProblemError
-from ..export.json import JsonExport
+from ..render.json import JsonExport
 from ..problems.oscillator import Oscillator
 from ..results.expansion import Expansion
 from .errors import _as_epsilons, _fit_or_nan

@@ -50,7 +50,7 @@ import numpy as np
 
 from .._errors import ProblemError
 from .._sweep import sweep_map
-from ..export.json import JsonExport
+from ..render.json import JsonExport
 from ..results.accuracy import ExpansionValidityWarning
 from ..problems.oscillator import Oscillator
 from ..results.expansion import Expansion

@@ -38,7 +38,7 @@ import sympy
 
 from .._errors import ProblemError, UnsupportedNonlinearityError
 from .._precision import LOCK, locked
-from ..export.json import JsonExport
+from ..render.json import JsonExport
 from ..results.expansion import Expansion
 from ..numerics.flow import ExactFlow, FlowResult
 from ..numerics.smooth import smooth_flow

@@ -35,7 +35,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from .._errors import ProblemError
-from ..export.json import JsonExport
+from ..render.json import JsonExport
 from ..results.expansion import Expansion
 from ..problems.oscillator import Oscillator
 from .solutions import (

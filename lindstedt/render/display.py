@@ -11,7 +11,7 @@ mpmath and numpy values are recognised by duck typing.
 
 Examples
 --------
->>> from lindstedt.export.display import format_number, labelled_repr, shorten
+>>> from lindstedt.render.display import format_number, labelled_repr, shorten
 >>> format_number(0.51763809020504152469)
 '0.5176380902'
 >>> labelled_repr("Point", [("x", format_number(1 / 3)), ("ok", "True")])

@@ -1,4 +1,4 @@
-"""The one JSON export layer: :func:`to_jsonable` for everything results hold, and the :class:`JsonExport` mixin.
+"""The one JSON encoding of results: :func:`to_jsonable` for everything results hold, and the :class:`JsonExport` mixin.
 
 Every result class of the package exports itself through this module.  A
 result is a frozen dataclass that derives from :class:`JsonExport`, names its
@@ -189,7 +189,7 @@ def to_jsonable(value: Any) -> Any:
 @locked
 def display_value(value: Any) -> str:
     """A field of a result as short text for people: numbers to 10 digits, vectors cut to 8 entries,
-    nested results and problems by name, long text shortened (see :mod:`lindstedt.export.display`).
+    nested results and problems by name, long text shortened (see :mod:`lindstedt.render.display`).
 
     Examples
     --------

@@ -1,5 +1,6 @@
 """Names in generated code: the reserved words of each target and the renaming of clashing arguments
-(shared by :mod:`lindstedt.export.codegen` and its targets, :mod:`lindstedt.export._targets`)."""
+(shared by :mod:`lindstedt.export.codegen`, its targets :mod:`lindstedt.export._targets`, and the NumPy source of
+the stable series that the float evaluators compile, :mod:`lindstedt.compiled.stable_source`)."""
 
 from __future__ import annotations
 

@@ -1,0 +1,363 @@
+"""The float evaluators of an expansion of ``u'' + ω0² u + ε f(u) = 0``: ω(ε) = Σ_k ω_k ε^k and
+u(t) ≈ Σ_{k≤N} ε^k v_k(ω t + φ(ε)), with their error estimates and the warnings that judge ε.
+
+These are the bodies of :meth:`lindstedt.Expansion.frequency`, :meth:`~lindstedt.Expansion.displacement`,
+:meth:`~lindstedt.Expansion.velocity`, :meth:`~lindstedt.Expansion.frequency_coefficients`, the error estimates
+and :meth:`~lindstedt.Expansion.epsilon_range` (documented there).  They read the parameter values through
+:mod:`lindstedt.results._values` and the float coefficients through :mod:`lindstedt.results._coefficients`.
+ε is judged against the orbit's range (:mod:`lindstedt.results.orbit_range`: an error where no periodic orbit
+exists, a warning outside the contact regime or beyond the radius of convergence) and against the series' own
+terms: the warnings read ω_{N+1} (ω_{N+2} for the phase drift) only where they could speak, i.e. where a stand-in
+as large as :func:`lindstedt.results.accuracy.next_term_bound` would make them speak.
+
+Functions of an :class:`~lindstedt.Expansion`, typed ``Any``: :mod:`lindstedt.results.expansion` imports this
+module, never the other way round.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from .._errors import ParameterError, ProblemError
+from .._precision import LOCK, locked, warn_caller
+from ..problems.parsing import parse_floats
+from ._coefficients import (
+    WARNING_TOLERANCE,
+    float_branches,
+    frequency_coefficients,
+    omega_values,
+    phase_value,
+    phase_values,
+    waveform_data,
+    waveform_layout,
+)
+from ._values import UNSET, Point, omega_known, read, substitution, values_key
+from .accuracy import (
+    ExpansionValidityWarning,
+    branch_bound,
+    displacement_error,
+    gauge_values,
+    next_term_bound,
+    phase_warning,
+    quiet_radius,
+    series_warning,
+    series_warning_mask,
+)
+from .orbit_range import OrbitRange, orbit_range, range_function
+
+__all__ = ["coefficients", "displacement_error_estimate", "epsilon_range", "evaluate", "frequency", "truncation_error_estimate"]
+
+_RANGE_MEMORY = 4096  # parameter points whose OrbitRange an expansion keeps (small objects)
+
+
+def _horner(points: Any, coefficients: np.ndarray) -> Any:
+    """Σ_k c_k x^k by Horner's rule, c_k of shape P broadcast against x (as numpy's polyval for one P)."""
+    if coefficients.ndim == 1 and not np.ndim(points):  # plain floats: the same operations, without numpy's overhead
+        x, total = float(points), 0.0
+        for coefficient in coefficients[::-1].tolist():
+            total = total * x + coefficient
+        return np.float64(total)
+    result = coefficients[-1] + 0 * points
+    for coefficient in coefficients[-2::-1]:
+        result = result * points + coefficient
+    return result
+
+
+def _gauge_values(expansion: Any, epsilon: Any) -> np.ndarray:
+    """The gauge at ε (ε itself, or √ε: then ε must not be negative)."""
+    return gauge_values(
+        epsilon, expansion._steps, "the orbit stays on its side and the frequency is analytic: use "
+        "lindstedt.reference_solution, or expand the problem with f replaced by -f at -epsilon"
+    )
+
+
+# -- the frequency ---------------------------------------------------------------------------------------
+@locked
+def frequency(expansion: Any, epsilon: Any, values: Mapping[Any, Any] | None, order: int | None) -> Any:
+    """:meth:`lindstedt.Expansion.frequency` past its scalar fast path."""
+    epsilon = parse_floats(epsilon, what="epsilon")
+    last = expansion._steps * (expansion.order if order is None else order)
+    point = read(expansion, values)
+    if point is None:
+        return _frequency_exact(expansion, epsilon, values, last)
+    coefficients = omega_values(expansion, last, point)
+    points = _gauge_values(expansion, epsilon)
+    result = _horner(points, coefficients)
+    message = _range_message(expansion, epsilon, point, values) or _series_message(expansion, coefficients, last, points, point)
+    if message:
+        warn_caller(ExpansionValidityWarning(message))
+    if values is None and order is None and not point.arrays and expansion._steps == 1 and not message:
+        _set_fast_frequency(expansion, coefficients, last)
+    return float(result) if np.ndim(result) == 0 else result
+
+
+def _frequency_exact(expansion: Any, epsilon: Any, values: Mapping[Any, Any] | None, last: int) -> Any:
+    """ω(ε) from the exactly substituted coefficients (values a double cannot hold)."""
+    coefficients = frequency_coefficients(expansion, last + 1, values)
+    points = _gauge_values(expansion, epsilon)
+    result = np.polynomial.polynomial.polyval(points, coefficients[: last + 1])
+    message = _range_message(expansion, epsilon, None, values) or series_warning(coefficients, last, points, expansion._floats.gauge)
+    if message:
+        warn_caller(ExpansionValidityWarning(message))
+    return float(result) if np.ndim(result) == 0 else result
+
+
+def _set_fast_frequency(expansion: Any, coefficients: np.ndarray, last: int) -> None:
+    """Enable the scalar fast path of :meth:`~lindstedt.Expansion.frequency` (no free symbols, gauge ε): Horner in
+    Python floats for |ε| up to the radius below which no warning can speak (with the next term, or its stand-in
+    while ω_{N+1} is not derived: beyond that radius the general path derives it)."""
+    known = omega_known(expansion, last + 1)
+    current = expansion.__dict__.get("_fast_frequency_known")
+    if current is not None and current >= known:
+        return
+    if known:
+        following = float(omega_values(expansion, last + 1, expansion._floats.no_parameters, WARNING_TOLERANCE)[last + 1])
+    else:
+        following = float(next_term_bound(coefficients))
+    radius = quiet_radius([*coefficients, following], last)
+    bounds = _range_at(expansion, ())
+    if bounds is not None:  # strictly inside the orbit's range and the disc of convergence
+        radius = min(radius, bounds.radius, bounds.upper, -bounds.lower) * (1 - 1e-9)
+    expansion.__dict__["_fast_frequency"] = (tuple(float(value) for value in coefficients[::-1]), radius)
+    expansion.__dict__["_fast_frequency_known"] = known
+
+
+def coefficients(expansion: Any, values: Mapping[Any, Any] | None, order: int | None) -> np.ndarray:
+    """:meth:`lindstedt.Expansion.frequency_coefficients`."""
+    last = expansion._steps * (expansion.order if order is None else order)
+    point = read(expansion, values)
+    if point is None:
+        return frequency_coefficients(expansion, last, values)[: last + 1].copy()
+    return omega_values(expansion, last, point).copy()
+
+
+def truncation_error_estimate(expansion: Any, epsilon: Any, values: Mapping[Any, Any] | None, order: int | None) -> Any:
+    """:meth:`lindstedt.Expansion.truncation_error_estimate`."""
+    epsilon = parse_floats(epsilon, what="epsilon")
+    last = expansion._steps * (expansion.order if order is None else order)
+    point = read(expansion, values)
+    if point is None:
+        coefficient = frequency_coefficients(expansion, last + 1, values)[last + 1]
+    else:  # vectorised over parameter arrays too
+        coefficient = omega_values(expansion, last + 1, point)[last + 1]
+    estimate = np.abs(coefficient * _gauge_values(expansion, epsilon) ** (last + 1))
+    message = _range_message(expansion, epsilon, point, values)
+    if message:
+        warn_caller(ExpansionValidityWarning(message))
+    return estimate
+
+
+# -- the displacement and the velocity ---------------------------------------------------------------
+def evaluate(expansion: Any, t: Any, epsilon: Any, values: Mapping[Any, Any] | None, derivative: bool) -> Any:
+    """:meth:`lindstedt.Expansion.displacement` (``derivative=False``) and :meth:`~lindstedt.Expansion.velocity`."""
+    t, epsilon = parse_floats(t, what="t"), parse_floats(epsilon, what="epsilon")
+    steps = expansion._steps
+    with LOCK:  # the values read, the float data (compiled on first use) and the warnings: sympy on a slow path
+        point = read(expansion, values)
+        if point is None or expansion._stretched_pieces:
+            return _evaluate_exact(expansion, t, epsilon, values, derivative)
+        last = steps * expansion.order
+        coefficients = omega_values(expansion, last + 1, point)  # the frequency through ω_{N+1}
+        eta = _gauge_values(expansion, epsilon)
+        times = np.asarray(t, dtype=float)
+        frequency = _horner(eta, coefficients)
+        message = _range_message(expansion, epsilon, point, values) or _series_message(
+            expansion, coefficients[: last + 1], last, eta, point, coefficients[last + 1])
+        if message is None:
+            message = _drift_message(expansion, coefficients, last, eta, times, point)
+        if message:
+            warn_caller(ExpansionValidityWarning(message))
+        phase = _horner(eta, phase_values(expansion, point)) if expansion.problem.has_initial_velocity else None
+        layout = expansion._floats.layout
+        if layout is None:
+            layout = waveform_layout(expansion)
+        data = waveform_data(expansion, layout, point, float(np.max(np.abs(eta))) if eta.size else 0.0)  # accurate for the largest |η|
+    # floats only from here: the waveform over the times runs lock-free (numpy releases the GIL on large arrays)
+    strained = times * frequency if phase is None else times * frequency + phase
+    scaled = data.scale ** (1 / steps) * eta
+    result = data.amplitude * layout.evaluate(data, strained, scaled, derivative)
+    if derivative:
+        result = result * frequency
+    return result if result.ndim else float(result)
+
+
+def _evaluate_exact(expansion: Any, t: Any, epsilon: Any, values: Mapping[Any, Any] | None, derivative: bool) -> Any:
+    """The evaluator on exactly substituted data (values a double cannot hold; stretched contact arcs)."""
+    if np.ndim(epsilon):
+        raise ProblemError(
+            "epsilon must be one number here (exact parameter values or a stretched contact arc); "
+            "loop over epsilon, or give the parameter values as floats"
+        )
+    scale, amplitude, branches = float_branches(expansion, values)
+    gauge, frequency, message, drift = _at_epsilon(expansion, float(epsilon), values)
+    times = np.asarray(t, dtype=float)
+    message = _range_message(expansion, epsilon, None, values) or message
+    if message is None:
+        message = phase_warning(drift, times)
+    if message:
+        warn_caller(ExpansionValidityWarning(message))
+    strained = times * frequency + phase_value(expansion, gauge, values)
+    result = amplitude * branches.evaluate(strained, scale ** (1 / expansion._steps) * gauge, derivative)[..., 0]
+    if derivative:
+        result = result * frequency
+    return result if result.ndim else float(result)
+
+
+def _at_epsilon(expansion: Any, epsilon: float, values: Mapping[Any, Any] | None) -> tuple[float, float, str | None, float]:
+    """Per ε (cached): the gauge η, the frequency ω through ω_{n+1}, the series' warning (or None) and the
+    phase drift rate |ω_{n+2} η^{n+2}| (the frequency is used through ω_{n+1})."""
+
+    def compute() -> tuple[float, float, str | None, float]:
+        gauge = float(_gauge_values(expansion, epsilon))
+        last = expansion._steps * expansion.order
+        coefficients = frequency_coefficients(expansion, last + 2, values)
+        frequency = float(np.polynomial.polynomial.polyval(gauge, coefficients[: last + 2]))
+        message = series_warning(coefficients[: last + 2], last, np.array([gauge]), expansion._floats.gauge)
+        return gauge, frequency, message, abs(float(coefficients[last + 2])) * abs(gauge) ** (last + 2)
+
+    # one slot per values: repeated evaluations at one ε hit it, a sweep over ε does not grow the cache
+    cache = expansion._floats.cache
+    key = ("at", values_key(values))
+    cached = cache.get(key)
+    if cached is None or cached[0] != epsilon:
+        cached = cache[key] = (epsilon, compute())
+    return cached[1]
+
+
+def displacement_error_estimate(expansion: Any, t: Any, epsilon: float, values: Mapping[Any, Any] | None) -> np.ndarray:
+    """:meth:`lindstedt.Expansion.displacement_error_estimate`."""
+    t, epsilon = parse_floats(t, what="t"), parse_floats(epsilon, what="epsilon", scalar=True)
+    steps = expansion._steps
+    scale, amplitude, branches = float_branches(expansion, values)
+    last = steps * expansion.order
+    eta = float(_gauge_values(expansion, float(epsilon)))
+    message = _range_message(expansion, epsilon, None, values)
+    if message:
+        warn_caller(ExpansionValidityWarning(message))
+    # The displacement pairs v_0 … v_n with ω through ω_{n+1}: its phase drifts with the next terms, one power of ε
+    # of them (two in the gauge ε^{1/2}, whose analytic and non-analytic terms interleave).
+    coefficients = frequency_coefficients(expansion, last + 1 + steps, values)
+    frequency_error = sum(abs(coefficients[k]) * abs(eta) ** k for k in range(last + 2, last + 2 + steps))
+    scaled = abs(scale) ** (1 / steps) * eta  # η̂, the normalised gauge of the waveforms
+    neglected = abs(amplitude) * scaled ** (last + 1) * branch_bound(branches.terms[last], branches.shifts[0])
+    return displacement_error(amplitude, frequency_error, np.asarray(t, dtype=float), neglected)
+
+
+# -- what judges ε: the orbit's range and the series' terms ------------------------------------------
+def epsilon_range(expansion: Any, values: Mapping[Any, Any] | None) -> OrbitRange | None:
+    """:meth:`lindstedt.Expansion.epsilon_range`."""
+    point = read(expansion, values)
+    if point is not None and point.shape:
+        raise ParameterError("epsilon_range takes one parameter point: give scalar values")
+    return _range_at(expansion, _range_arguments(expansion, point, values))
+
+
+def _range_source(expansion: Any) -> Callable[..., tuple[Any, ...]] | None:
+    state = expansion._floats
+    if state.range_source is UNSET:
+        state.range_source = range_function(expansion.problem, state.symbols)
+    return state.range_source
+
+
+def _range_arguments(expansion: Any, point: Point | None, values: Mapping[Any, Any] | None) -> tuple[float, ...]:
+    if point is not None:
+        return tuple(float(value) for value in point.arrays)
+    exact = substitution(expansion, values)
+    return tuple(float(exact[symbol]) for symbol in expansion._floats.symbols)
+
+
+def _range_at(expansion: Any, arguments: tuple[float, ...], source: Any = UNSET) -> OrbitRange | None:
+    """The :class:`OrbitRange` at float parameter values (about 1.6 ms each; the last _RANGE_MEMORY points kept, so
+    that a repeated sweep over an array of parameter values pays it once); ``source`` is :func:`_range_source`."""
+    if source is UNSET:
+        source = _range_source(expansion)
+    if source is None:
+        return None
+    memory = expansion._floats.cache.setdefault("ranges", OrderedDict())
+    if arguments not in memory:
+        memory[arguments] = orbit_range(*source(*arguments), expansion._steps)
+        if len(memory) > _RANGE_MEMORY:
+            memory.popitem(last=False)
+    return memory[arguments]
+
+
+def _range_message(expansion: Any, epsilon: Any, point: Point | None, values: Mapping[Any, Any] | None) -> str | None:
+    """Raise where no periodic orbit exists at some ε; else the warning for ε outside the derivation's regime
+    or beyond the radius of convergence (see :meth:`~lindstedt.Expansion.epsilon_range`), or None."""
+    state = expansion._floats
+    source = state.range_source
+    if source is UNSET:
+        source = _range_source(expansion)
+    if source is None:
+        return None
+    gauge = state.gauge
+    if point is None or not point.shape:
+        bounds = _range_at(expansion, _range_arguments(expansion, point, values), source)
+        return bounds.judge(epsilon, gauge)
+    arrays = np.broadcast_arrays(np.asarray(epsilon, dtype=float), *[np.asarray(value, dtype=float) for value in point.arrays])
+    columns = np.stack([array.reshape(-1) for array in arrays[1:]], axis=1)
+    epsilons = arrays[0].reshape(-1)
+    unique, inverse = np.unique(columns, axis=0, return_inverse=True)
+    for index, row in enumerate(unique):
+        message = _range_at(expansion, tuple(float(value) for value in row), source).judge(epsilons[inverse.reshape(-1) == index], gauge)
+        if message:
+            given = ", ".join(f"{name} = {value:.6g}" for name, value in zip(state.names, row))
+            return f"at {given}: {message}"
+    return None
+
+
+def _series_message(expansion: Any, coefficients: np.ndarray, last: int, eta: np.ndarray, point: Point,
+                    following: np.ndarray | None = None) -> str | None:
+    """:func:`series_warning` for ω_0 … ω_last at these gauge values, deriving ω_{last+1} only where it could
+    make the warning speak (if ``following`` is not given and it is not derived yet): below the radius where
+    a next term as large as :func:`next_term_bound` would speak, it cannot."""
+    if last < 1 or eta.size == 0:
+        return None
+    gauge = expansion._floats.gauge
+    if following is None and omega_known(expansion, last + 1):
+        following = omega_values(expansion, last + 1, point, WARNING_TOLERANCE)[last + 1]
+    if not point.shape:  # one coefficient set: the largest |η| decides, as series_warning reads it
+        if following is None:
+            size = np.array([float(np.max(np.abs(eta)))])
+            if series_warning([*coefficients.tolist(), float(next_term_bound(coefficients))], last, size, gauge) is None:
+                return None
+            following = omega_values(expansion, last + 1, point, WARNING_TOLERANCE)[last + 1]
+        return series_warning([*coefficients.tolist(), float(following)], last, np.asarray(eta), gauge)
+    size = np.abs(eta)  # one coefficient set per element: each element is judged at its own |η|
+    if following is None:
+        stand_in = next_term_bound(coefficients)
+        if not series_warning_mask(np.concatenate([coefficients, stand_in[None]]), last, size).any():
+            return None
+        following = omega_values(expansion, last + 1, point, WARNING_TOLERANCE)[last + 1]
+    table = np.concatenate([coefficients, np.asarray(following)[None]])
+    speaking = series_warning_mask(table, last, size)
+    if not speaking.any():
+        return None
+    index = int(np.argmax(speaking))
+    rows = table.reshape(table.shape[0], *[1] * (speaking.ndim - table.ndim + 1), *table.shape[1:])
+    column = np.broadcast_to(rows, (table.shape[0], *speaking.shape)).reshape(table.shape[0], -1)[:, index]
+    return series_warning(list(column), last, np.array([np.broadcast_to(size, speaking.shape).flat[index]]), gauge)
+
+
+def _drift_message(expansion: Any, coefficients: np.ndarray, last: int, eta: np.ndarray, times: np.ndarray,
+                   point: Point) -> str | None:
+    """:func:`phase_warning` with the drift rate |ω_{last+2} η^{last+2}|; ω_{last+2} is derived only if a next
+    term as large as :func:`next_term_bound` could make the drift reach one radian at these times."""
+    if times.size == 0:
+        return None
+    power = np.abs(eta) ** (last + 2)
+    longest = float(np.max(np.abs(times)))
+    if not omega_known(expansion, last + 2):
+        stand_in = next_term_bound(coefficients[: last + 2])
+        if not float(np.max(stand_in * power)) * longest >= 1.0:
+            return None
+    rate = np.abs(omega_values(expansion, last + 2, point, WARNING_TOLERANCE)[last + 2]) * power
+    if not np.shape(rate):
+        return phase_warning(float(rate), times)
+    drift = np.abs(rate * times) if times.ndim else np.abs(rate) * longest
+    index = int(np.argmax(drift))
+    broadcast = np.broadcast_to(times, drift.shape) if times.ndim else np.full(drift.shape, longest)
+    return phase_warning(float(np.broadcast_to(rate, drift.shape).flat[index]), np.array([broadcast.flat[index]]))
