@@ -4,8 +4,10 @@ Every ``import`` and ``from … import`` of every module of ``lindstedt/`` — a
 alike (a deferred import is still a dependency) — is read from the source with ``ast``, and the strongly connected
 components of the graph are the import circles: there is none.  The layers depend one way — problems, engine and
 algebra below the methods, the methods build results, results never import a method (an unpickled result is
-derived again by the method object it keeps) and the export layer reads results; among the numerics the flows
-report what the drivers need (their linear frequencies) and the drivers import the flows.
+derived again by the method object it keeps) nor the export layer (their display and JSON primitives are in
+``render``, their compiled float machinery in ``compiled``, both below them), and the export layer reads results;
+among the numerics the flows report what the drivers need (their linear frequencies) and the drivers import the
+flows.
 """
 
 from __future__ import annotations
@@ -113,3 +115,10 @@ def test_results_import_no_method():
     for name, targets in graph.items():
         if name.startswith("lindstedt.results"):
             assert not [target for target in targets if target.startswith("lindstedt.methods")], name
+
+
+def test_results_import_no_export():
+    graph = _graph()
+    for name, targets in graph.items():
+        if name.startswith("lindstedt.results"):
+            assert not [target for target in targets if target.startswith("lindstedt.export")], name
