@@ -65,7 +65,7 @@ from ._views import expansion_dict, expansion_repr, expansion_summary
 from .accuracy import ExpansionValidityWarning
 from .assumptions import DerivationAssumptions
 from .orbit_range import OrbitRange
-from .stretched_arcs import STRETCHED_TIME, StretchedArcSeries
+from .stretched_arcs import STRETCHED_TIME, StretchedArcSeries, arc_series
 from .waveforms import STRAINED_TIME, PiecewiseWaveform, Waveform
 
 __all__ = ["Expansion", "ExpansionValidityWarning", "Waveform", "PiecewiseWaveform", "STRAINED_TIME", "EPSILON", "TIME"]
@@ -243,27 +243,7 @@ class Expansion:
         """The contact arcs expanded in stretched time (non-polynomial contact laws; empty otherwise)."""
         if not self.is_piecewise:
             return ()
-        result = []
-        highest = self._steps * self.order
-        hierarchy = self._hierarchy
-        for which, arc in enumerate(self._form.system.arcs):
-            if arc is None:
-                continue
-            lengths = tuple(hierarchy.arc_length(which, n) for n in range(highest + 1))  # mpf already: mpmath.mpf() would round to mp.prec
-            series = [arc.series(n) for n in range(highest + 1)]
-            result.append(StretchedArcSeries(
-                side="release" if which == 0 else "far",
-                sign=1 if which == 0 else -1,
-                denominator=arc.denominator,
-                exponent=None if arc.exponent is None else str(arc.exponent),
-                contact_point=arc.kappa,
-                length=lengths,
-                mu=tuple(arc.mu(n) for n in range(highest + 1)),
-                chebyshev=tuple(tuple(values) for values, _ in series),
-                slope_chebyshev=tuple(tuple(slopes) for _, slopes in series),
-                digits=arc.digits,
-            ))
-        return tuple(result)
+        return arc_series(self._hierarchy, self._form.system.arcs, self._steps * self.order)
 
     def _solve_through(self, highest: int) -> int:
         """Solve the hierarchy through order ``highest`` in one pass (so that its checkpoints report progress

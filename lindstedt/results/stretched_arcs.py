@@ -21,7 +21,7 @@ from ..render.display import DIGITS, format_number, format_vector, jupyter_latex
 from ..render.json import JsonExport
 from .._precision import locked_methods, workdps
 
-__all__ = ["STRETCHED_TIME", "StretchedArcSeries"]
+__all__ = ["STRETCHED_TIME", "StretchedArcSeries", "arc_series"]
 
 
 STRETCHED_TIME = sympy.Symbol("tau", nonnegative=True)
@@ -171,3 +171,27 @@ class StretchedArcSeries(JsonExport):
             "chebyshev": [[text(value) for value in row] for row in self.chebyshev],
             "slope_chebyshev": [[text(value) for value in row] for row in self.slope_chebyshev],
         }
+
+
+def arc_series(hierarchy: Any, arcs: tuple[Any, Any], highest: int) -> tuple[StretchedArcSeries, ...]:
+    """The stretched arcs of a piecewise hierarchy through order ``highest`` of the gauge (``arcs``: the engine's
+    arc at the release and at the far turning point, None where the piece is polynomial)."""
+    result = []
+    for which, arc in enumerate(arcs):
+        if arc is None:
+            continue
+        lengths = tuple(hierarchy.arc_length(which, n) for n in range(highest + 1))  # mpf already: mpmath.mpf() would round to mp.prec
+        series = [arc.series(n) for n in range(highest + 1)]
+        result.append(StretchedArcSeries(
+            side="release" if which == 0 else "far",
+            sign=1 if which == 0 else -1,
+            denominator=arc.denominator,
+            exponent=None if arc.exponent is None else str(arc.exponent),
+            contact_point=arc.kappa,
+            length=lengths,
+            mu=tuple(arc.mu(n) for n in range(highest + 1)),
+            chebyshev=tuple(tuple(values) for values, _ in series),
+            slope_chebyshev=tuple(tuple(slopes) for _, slopes in series),
+            digits=arc.digits,
+        ))
+    return tuple(result)
