@@ -1,14 +1,15 @@
-"""The period map of a harmonically forced system: what shooting, continuation and Floquet analysis need.
+"""The period map: the one protocol through which the periodic-orbit core sees every flow.
 
 For ``z = (X, X')`` and the forcing ``ε s P cos(Ω t)`` (``s`` scales the load of the problem, 1 by
 default), the period map over ``k`` forcing periods is
 
     Π(z0; Ω, s) = z(k T; z0),    T = 2π/Ω,    z(0) = z0,
 
-and a periodic response of period ``k T`` is a fixed point ``Π(z0) = z0``.  Every flow that computes
-forced responses (the exact event-driven flow for piecewise-linear laws, the DOP853 flow with its
-variational equations for any law) implements :class:`PeriodMap`; the shooting, continuation and
-bifurcation code only talk to this interface.
+and a periodic response of period ``k T`` is a fixed point ``Π(z0) = z0``.  Every flow implements
+:class:`PeriodMap`: the exact event-driven flows for piecewise-linear laws (forced, :class:`ForcedFlow`, and
+free, :class:`ExactFlow`, where Ω is the orbit's own frequency, the load is absent and the map also gives
+``∂Π/∂ε``) and the DOP853 flow with its variational equations for any law (:class:`SmoothForcedFlow`); the
+shooting of forced orbits and of NNMs, the continuation and the bifurcation code talk to this interface.
 """
 
 from __future__ import annotations
@@ -42,6 +43,9 @@ class PeriodMapValue:
         ``∂Π/∂s`` at fixed z0 and Ω.
     counters : dict
         Cost counters (e.g. ``arcs``, ``switches``, ``steps``, ``evaluations``).
+    d_epsilon : numpy.ndarray, shape (2N,) or None
+        ``∂Π/∂ε`` at fixed z0 and Ω, from the flows that give it when asked (the exact free flow:
+        continuation of NNMs in ε).
     """
 
     state: np.ndarray
@@ -49,6 +53,7 @@ class PeriodMapValue:
     d_frequency: np.ndarray | None = None
     d_forcing: np.ndarray | None = None
     counters: dict[str, int] = field(default_factory=dict)
+    d_epsilon: np.ndarray | None = None
 
 
 @runtime_checkable

@@ -68,20 +68,16 @@ of the arcs.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Callable, Sequence
+from dataclasses import dataclass, replace
+from typing import Any, Sequence
 
 import numpy as np
 
-from .._errors import ProblemError
-from .._precision import locked
-from ..render.display import format_number, format_vector, html_table, labelled_repr
-from ..render.json import JsonExport, exported_fields, to_jsonable
+from .._errors import ConvergenceError, ProblemError
+from ._period_map import PeriodMapValue
 from ..problems.system import UnilateralSystem
+from .flow_results import FlowMapResult, FlowResult, SwitchEvent
 from .switching import _Bracket, _Counters, _earliest_switch, _first_exit_trig, _SearchFailure
-
-if TYPE_CHECKING:
-    from ..problems.forced import ForcedOscillator, ForcedSystem
 
 __all__ = ["ExactFlow", "FlowResult", "FlowMapResult", "SwitchEvent"]
 
@@ -98,264 +94,23 @@ _LONG = np.longdouble
 _CLUSTER_RTOL = 1e-9
 
 
-# --------------------------------------------------------------------------- #
-# results
-# --------------------------------------------------------------------------- #
-@dataclass(frozen=True, repr=False)
-class SwitchEvent(JsonExport):
-    """A switch of one unilateral spring.
+def _duhamel_kernels(omega_k: np.ndarray, omega_m: np.ndarray, tau: float) -> tuple[np.ndarray, ...]:
+    """Responses ζ(τ), ζ'(τ) of ζ'' + ω_k² ζ = cos(ω_m s) or sin(ω_m s), ζ(0) = ζ'(0) = 0.
 
-    Attributes
-    ----------
-    time : float
-        Switching time.
-    spring : int
-        Index of the spring (row of ``A``); for :func:`smooth_flow`, the index
-        of the event function.
-    direction : int
-        +1 when the spring engages (``g`` becomes positive), −1 when it releases
-        (for :func:`smooth_flow`: the sign of the event function's slope).
-
-    JSON schema ``lindstedt.switch-event/1`` (:meth:`to_json`).
+    Written with σ = (ω_k + ω_m)/2, δ = ω_m − ω_k and sinc so that they stay
+    accurate for ω_m → ω_k (resonance: the τ sin, τ cos terms).
     """
+    sigma = 0.5 * (omega_k + omega_m)
+    delta = omega_m - omega_k
+    sinc = np.sinc(delta * tau / (2.0 * math.pi))  # sin(δτ/2)/(δτ/2)
+    sin_sigma, cos_sigma = np.sin(sigma * tau), np.cos(sigma * tau)
+    sin_k = np.sin(omega_k * tau)
+    cos_response = tau * sin_sigma * sinc / (2.0 * sigma)
+    cos_rate = (omega_m * tau * cos_sigma * sinc + sin_k) / (2.0 * sigma)
+    sin_response = (sin_k / omega_k - tau * cos_sigma * sinc) / (2.0 * sigma)
+    sin_rate = omega_m * tau * sin_sigma * sinc / (2.0 * sigma)
+    return cos_response, cos_rate, sin_response, sin_rate
 
-    SCHEMA = "lindstedt.switch-event/1"
-
-    time: float
-    spring: int
-    direction: int
-
-
-@dataclass(frozen=True)
-class FlowResult(JsonExport):
-    """Trajectory returned by :meth:`ExactFlow.solve`, :func:`smooth_flow` and :meth:`ForcedFlow.solve`.
-
-    Attributes
-    ----------
-    success : bool
-        Whether ``t_end`` was reached.
-    message : str
-        What happened (why it stopped, when it failed).
-    method : str
-        ``"exact"`` (closed-form arcs), ``"exact-forced"`` (:class:`ForcedFlow`) or ``"DOP853"``.
-    t_final : float
-        Last time reached (``t_end`` on success).
-    position, velocity : numpy.ndarray, shape (N,)
-        State at ``t_final``.
-    events : tuple of SwitchEvent
-        Switches in time order.
-    n_switches : int
-        Number of spring switches (0 for ``smooth_flow``).
-    n_root_solves : int
-        Bracketed root solves (Brent) for switching times, or events located
-        by ``solve_ivp``.
-    n_arcs : int
-        Closed-form arcs, including the restarts that keep each arc shorter
-        than four periods of its slowest mode (1 for ``smooth_flow``).
-    n_evaluations : int
-        Gap-function evaluations of the switch search, or right-hand-side
-        evaluations of ``solve_ivp``.
-    n_decompositions : int
-        Modal decompositions computed for this run (cache misses).
-    contact_states : tuple of tuple of int
-        Distinct contact states visited, in order of first visit, each given by
-        its engaged springs.
-    system : UnilateralSystem, ForcedSystem, ForcedOscillator or None
-        The problem flowed: the :class:`UnilateralSystem` of :meth:`ExactFlow.solve`,
-        the forced problem of :meth:`ForcedFlow.solve`; None for :func:`smooth_flow`,
-        whose right-hand side is a function.  Exported exactly, as
-        :meth:`UnilateralSystem.to_json_dict` or :meth:`ForcedSystem.to_json_dict`;
-        a :class:`ForcedOscillator` as its equation (``description``) and its ``f``,
-        ``params``, ``omega0``, ``zeta`` and ``forcing`` as strings (the arguments that rebuild it).
-    epsilon : float or None
-        ε of the flow (:meth:`ExactFlow.solve`, :meth:`ForcedFlow.solve`).
-
-    JSON schema ``lindstedt.flow/1`` (:meth:`to_json`; the dense output is not exported).
-    """
-
-    SCHEMA = "lindstedt.flow/1"
-
-    success: bool
-    message: str
-    method: str
-    t_final: float
-    position: np.ndarray
-    velocity: np.ndarray
-    events: tuple[SwitchEvent, ...]
-    n_switches: int
-    n_root_solves: int
-    n_arcs: int
-    n_evaluations: int
-    n_decompositions: int
-    contact_states: tuple[tuple[int, ...], ...]
-    _evaluator: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] = field(repr=False, compare=False)
-    system: UnilateralSystem | ForcedSystem | ForcedOscillator | None = field(default=None, repr=False, compare=False)
-    epsilon: float | None = field(default=None, repr=False, compare=False)
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dictionary (see :class:`~lindstedt.export.json.JsonExport`); a forced problem as in ``system`` above.
-
-        Examples
-        --------
-        >>> from lindstedt.numerics.forced_flow import ForcedFlow
-        >>> from lindstedt.problems.forced import ForcedOscillator
-        >>> run = ForcedFlow(ForcedOscillator("Max(0, u - 1/5)", omega0=1, zeta="1/20"), 0.5).solve([0.0, 0.0], 5.0, 1.2)
-        >>> run.to_dict()["system"]["zeta"]
-        '1/20'
-        """
-        data: dict[str, Any] = {"schema": type(self).SCHEMA}
-        for item in exported_fields(self):
-            value = getattr(self, item.name)
-            data[item.name] = _problem_json(value) if item.name == "system" else to_jsonable(value)
-        return data
-
-    @property
-    def n_states_visited(self) -> int:
-        """Number of distinct contact states visited."""
-        return len(self.contact_states)
-
-    def state(self, t: Any) -> tuple[np.ndarray, np.ndarray]:
-        """Positions and velocities at the times ``t`` (scalar or array) in ``[0, t_final]``.
-
-        Returns
-        -------
-        (X, V) : numpy.ndarray
-            Each of shape ``t.shape + (N,)``.
-        """
-        times = np.asarray(t, dtype=float)
-        if not np.all(np.isfinite(times)):
-            raise ProblemError("state(t) needs finite times")
-        slack = 4 * _EPS * max(1.0, self.t_final)
-        if times.size and (times.min() < -slack or times.max() > self.t_final + slack):
-            raise ProblemError(
-                f"state(t) is defined on [0, {self.t_final}] only, got times in [{times.min()}, {times.max()}]; "
-                "solve over a longer interval"
-            )
-        flat = np.clip(times.reshape(-1), 0.0, self.t_final)
-        positions, velocities = self._evaluator(flat)
-        n = positions.shape[-1]
-        return positions.reshape(times.shape + (n,)), velocities.reshape(times.shape + (n,))
-
-    # -- display -----------------------------------------------------------------------------
-    def _display_rows(self, quoted: bool = True) -> list[tuple[str, str]]:
-        events = ", ".join(
-            f"t={format_number(e.time, 6)} spring {e.spring} {'on' if e.direction > 0 else 'off'}" for e in self.events[:3]
-        )
-        if len(self.events) > 3:
-            events += f", … ({len(self.events)} events; all in .events)"
-        return [
-            ("success", str(bool(self.success))),
-            ("message", repr(self.message) if quoted else self.message),
-            ("method", repr(self.method) if quoted else self.method),
-            ("t_final", format_number(self.t_final)),
-            ("position", format_vector(self.position)),
-            ("velocity", format_vector(self.velocity)),
-            ("events", f"[{events}]"),
-            ("n_switches", str(self.n_switches)),
-            ("n_root_solves", str(self.n_root_solves)),
-            ("n_arcs", str(self.n_arcs)),
-            ("n_evaluations", str(self.n_evaluations)),
-            ("n_decompositions", str(self.n_decompositions)),
-            ("contact_states", format_vector([str(list(state)) for state in self.contact_states], limit=6)
-             .replace("'", "")),
-        ]
-
-    def __repr__(self) -> str:
-        """Outcome, final state and cost counters; at most three events (``.events`` holds them all).
-
-        Examples
-        --------
-        >>> import lindstedt
-        >>> run = lindstedt.ExactFlow(lindstedt.UnilateralSystem.one_dof(1), 0.5).solve([1.0], [0.0], 10.0)
-        >>> text = repr(run)
-        >>> "success=True" in text and "n_switches=" in text and len(text) < 1500
-        True
-        """
-        return labelled_repr("FlowResult", self._display_rows())
-
-    def _repr_html_(self) -> str:
-        """Jupyter's rendering: a two-column table of :meth:`__repr__`'s fields."""
-        return html_table(f"FlowResult: {'success' if self.success else 'FAILED'}", self._display_rows(quoted=False))
-
-
-@locked  # sympy printing
-def _problem_json(problem: Any) -> Any:
-    """The JSON form of the problem a flow ran on (forced problems included)."""
-    from ..problems.forced import ForcedOscillator, ForcedSystem  # here: import lindstedt stays light
-
-    if isinstance(problem, ForcedSystem):
-        return problem.to_json_dict()
-    if isinstance(problem, ForcedOscillator):
-        import sympy
-
-        return {
-            "description": problem.describe(),
-            "f": sympy.sstr(problem.f),
-            "params": {str(name): None if value == name else sympy.sstr(value) for name, value in problem.params},
-            "omega0": sympy.sstr(problem.omega0),
-            "zeta": sympy.sstr(problem.zeta),
-            "forcing": sympy.sstr(problem.forcing),
-        }
-    return to_jsonable(problem)
-
-
-@dataclass(frozen=True)
-class FlowMapResult(JsonExport):
-    """Result of :meth:`ExactFlow.flow_map`.
-
-    Attributes
-    ----------
-    success, message : bool, str
-        As in :class:`FlowResult`.
-    position, velocity : numpy.ndarray, shape (N,)
-        ``X(t)`` and ``X'(t)``.
-    sensitivity : numpy.ndarray of shape (2N, 2N) or None
-        ``∂(X(t), X'(t)) / ∂(X0, V0)`` when requested.
-    n_switches, n_root_solves, n_arcs, n_evaluations : int
-        Cost counters as in :class:`FlowResult`.
-    system : UnilateralSystem or None
-        The system flowed (exported exactly).
-    epsilon : float or None
-        ε of the flow.
-
-    JSON schema ``lindstedt.flow-map/1`` (:meth:`to_json`).
-    """
-
-    SCHEMA = "lindstedt.flow-map/1"
-
-    success: bool
-    message: str
-    position: np.ndarray
-    velocity: np.ndarray
-    sensitivity: np.ndarray | None
-    n_switches: int
-    n_root_solves: int
-    n_arcs: int
-    n_evaluations: int
-    system: UnilateralSystem | None = field(default=None, repr=False, compare=False)
-    epsilon: float | None = field(default=None, repr=False, compare=False)
-
-    def _display_rows(self, quoted: bool = True) -> list[tuple[str, str]]:
-        sensitivity = "None" if self.sensitivity is None else f"<{self.sensitivity.shape[0]}x{self.sensitivity.shape[1]} matrix; see .sensitivity>"
-        return [
-            ("success", str(bool(self.success))),
-            ("message", repr(self.message) if quoted else self.message),
-            ("position", format_vector(self.position)),
-            ("velocity", format_vector(self.velocity)),
-            ("sensitivity", sensitivity),
-            ("n_switches", str(self.n_switches)),
-            ("n_root_solves", str(self.n_root_solves)),
-            ("n_arcs", str(self.n_arcs)),
-            ("n_evaluations", str(self.n_evaluations)),
-        ]
-
-    def __repr__(self) -> str:
-        """Outcome, state and cost counters; the sensitivity matrix by its shape."""
-        return labelled_repr("FlowMapResult", self._display_rows())
-
-    def _repr_html_(self) -> str:
-        """Jupyter's rendering: a two-column table of :meth:`__repr__`'s fields."""
-        return html_table(f"FlowMapResult: {'success' if self.success else 'FAILED'}", self._display_rows(quoted=False))
 
 
 # --------------------------------------------------------------------------- #
@@ -798,6 +553,114 @@ class ExactFlow:
             "arcs": (arc_starts, arc_modes, arc_q0, arc_p0),
             "jacobian": jacobian,
         }
+
+    def _epsilon_derivative(self, run: dict[str, Any]) -> np.ndarray:
+        """``∂(X, X')(t)/∂ε`` of a dense run, in closed form.
+
+        It solves ``z' = J(t) z + (0, −M⁻¹ W (A X − b)_+)``, ``z(0) = 0``; the saltation matrices are the
+        identity because the vector field and its ε-derivative are continuous across the switching surfaces.
+        On each arc, in the modal coordinates (P, Q = P⁻¹, ω) of its contact state, the forcing is a constant
+        plus harmonics of the arc's own frequencies, and the Duhamel integral is summed in closed form
+        (:func:`_duhamel_kernels`).
+        """
+        system = self.system
+        n = system.n_dof
+        starts, modes, q0s, p0s = run["arcs"]
+        ends = [float(s) for s in starts[1:]] + [float(run["t"])]
+        mass_inverse_w = np.linalg.solve(system.M, system.W) if system.n_springs else np.zeros((n, 0))
+        z = np.zeros(2 * n)
+        for start, end, mode, q0_l, p0_l in zip(starts, ends, modes, q0s, p0s):
+            tau = end - float(start)
+            mask = np.array(mode.active, dtype=bool)
+            P, Q, omega = mode.basis, mode.projector, mode.omega
+            z = mode.transition(tau) @ z
+            if not mask.any():
+                continue
+            q0, p0 = q0_l.astype(float), p0_l.astype(float)
+            equilibrium = mode.equilibrium_l.astype(float)
+            load = mass_inverse_w[:, mask]
+            constant = -Q @ (load @ (system.A[mask] @ equilibrium - system.b[mask]))
+            coupling = -Q @ load @ (system.A[mask] @ P)  # (n, n): harmonic m forces modal k
+            cos_response, cos_rate, sin_response, sin_rate = _duhamel_kernels(omega[:, None], omega[None, :], tau)
+            cos_amplitude = coupling * q0[None, :]
+            sin_amplitude = coupling * (p0 / omega)[None, :]
+            zeta = constant * (1.0 - np.cos(omega * tau)) / omega**2 + np.sum(
+                cos_amplitude * cos_response + sin_amplitude * sin_response, axis=1
+            )
+            eta = constant * np.sin(omega * tau) / omega + np.sum(cos_amplitude * cos_rate + sin_amplitude * sin_rate, axis=1)
+            z = z + np.concatenate([P @ zeta, P @ eta])
+        return z
+
+    # --------------------------------------------------------------- the period map (the core's flow protocol)
+    @property
+    def dimension(self) -> int:
+        """2N, the size of the state z = (X, X')."""
+        return 2 * self.system.n_dof
+
+    def linear_frequencies(self) -> tuple[float, float] | None:
+        """(lowest, highest) linear frequency over the free system and the one with every spring engaged."""
+        system = self.system
+        stiffnesses = [system.K] + ([system.K + self.epsilon * system.W @ system.A] if system.n_springs else [])
+        squares = [float(x) for K in stiffnesses for x in np.linalg.eigvals(np.linalg.solve(system.M, K)).real]
+        roots = [math.sqrt(abs(x)) for x in squares if x != 0.0]
+        return (min(roots), max(roots)) if roots else None
+
+    def period_map(self, state0: Any, frequency: float, *, periods: int = 1, forcing_scale: float = 1.0,
+                   sensitivity: bool = True, d_epsilon: bool = False) -> PeriodMapValue:
+        """``Π(z0; Ω) = z(2πk/Ω)`` of the free flow with its exact derivatives (the forced flows' protocol).
+
+        ``d_state`` is the state transition matrix (the saltation matrices are the identity), ``d_frequency``
+        ``= −(2πk/Ω²) f(z(2πk/Ω))`` (the horizon moves with Ω), ``d_forcing`` zero (no load), ``d_epsilon`` the
+        closed-form ε-derivative when asked for; the counters hold the switches.  Raises
+        :class:`~lindstedt.ConvergenceError` when the flow fails.
+
+        Examples
+        --------
+        >>> flow = ExactFlow(UnilateralSystem.one_dof(1), epsilon=3.0)          # ω = 4/3 at any amplitude
+        >>> value = flow.period_map([1.0, 0.0], 4 / 3)
+        >>> np.round(value.state, 12).tolist(), value.counters["switches"]
+        ([1.0, 0.0], 2)
+        """
+        frequency = _as_time(frequency, "frequency")
+        if not frequency > 0:
+            raise ProblemError(f"frequency must be positive, got {frequency}")
+        horizon = 2.0 * math.pi * int(periods) / frequency
+        value = self.advance(state0, horizon, sensitivity=sensitivity, d_epsilon=d_epsilon)
+        if not sensitivity:
+            return value
+        n = self.system.n_dof
+        field = np.r_[value.state[n:], self.system.acceleration(value.state[:n], self.epsilon)]
+        return replace(value, d_frequency=-(horizon / frequency) * field, d_forcing=np.zeros(2 * n))
+
+    def advance(self, state0: Any, t: float, *, sensitivity: bool = True, d_epsilon: bool = False) -> PeriodMapValue:
+        """The state after time t with ``∂z(t)/∂z0`` (``sensitivity``) and ``∂z(t)/∂ε`` (``d_epsilon``): the
+        autonomous form of :meth:`period_map` (the NNM shooting flows over T/2 or T).
+
+        Examples
+        --------
+        >>> flow = ExactFlow(UnilateralSystem.one_dof(1), epsilon=0.0)
+        >>> (np.round(flow.advance([1.0, 0.0], np.pi).state, 12) + 0.0).tolist()
+        [-1.0, 0.0]
+        """
+        n = self.system.n_dof
+        z0 = _as_state_vector(state0, 2 * n, "state0")
+        run = self._run(z0[:n], z0[n:], t, dense=d_epsilon, sensitivity=sensitivity or d_epsilon)
+        if not run["success"]:
+            raise ConvergenceError(f"the flow failed: {run['message']}")
+        counters = {"switches": len(run["events"]), "arcs": run["cost"]["n_arcs"],
+                    "evaluations": run["cost"]["n_evaluations"]}
+        return PeriodMapValue(np.r_[run["x"], run["v"]], run["jacobian"] if sensitivity else None, counters=counters,
+                              d_epsilon=self._epsilon_derivative(run) if d_epsilon else None)
+
+    def sample(self, state0: Any, frequency: float, *, periods: int = 1, forcing_scale: float = 1.0,
+               samples: int = 256) -> tuple[np.ndarray, np.ndarray]:
+        """``(t, z(t))`` at ``samples`` equally spaced times of ``[0, 2πk/Ω)`` (dense closed-form output)."""
+        n = self.system.n_dof
+        z0 = _as_state_vector(state0, 2 * n, "state0")
+        horizon = 2.0 * math.pi * int(periods) / _as_time(frequency, "frequency")
+        times = np.linspace(0.0, horizon, int(samples), endpoint=False)
+        X, V = self.solve(z0[:n], z0[n:], horizon).state(times)
+        return times, np.hstack([X, V])
 
     # --------------------------------------------------------------- public API
     def solve(self, x0: Any, v0: Any, t_end: float) -> FlowResult:

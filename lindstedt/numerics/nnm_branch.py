@@ -36,7 +36,7 @@ from .arclength import tangent as unit_tangent
 from .forced_results import Bifurcation
 from .newton import Evaluation, NewtonOutcome, newton
 from .results import NNMBranch, NNMResult, _branch_events
-from .sensitivity import _check_epsilon, _integrate
+from .sensitivity import _check_epsilon, _map_over
 from .shooting import _STEP_TOL, _TWO_PI, NNMShooting, _Amplitude, _impossible_amplitude, nnm_energy
 
 _PARAMETERS = ("epsilon", "energy", "modal_amplitude")
@@ -559,13 +559,13 @@ def _seed_residual(problem: NNMShooting, eps: float, amplitude: _Amplitude, unkn
     if not (math.isfinite(period) and period > 0) or not np.all(np.isfinite(unknowns)):
         return np.full(2 * n + 1, 1e6)
     problem.flow_evaluations += 1
-    trajectory = _integrate(problem._flow(eps), x0, v0, period, sensitivity=False, d_epsilon=False)
-    if not trajectory.success:
+    trajectory = _map_over(problem._flow(eps), x0, v0, period, sensitivity=False, d_epsilon=False)
+    if isinstance(trajectory, str):
         return np.full(2 * n + 1, 1e6)
     energy = nnm_energy(problem.system, x0, v0, eps)
     return np.r_[
-        (trajectory.position - x0) / problem.position_scale,
-        (trajectory.velocity - v0) / problem.velocity_scale,
+        (trajectory.state[:n] - x0) / problem.position_scale,
+        (trajectory.state[n:] - v0) / problem.velocity_scale,
         (energy - amplitude.target(eps)) / problem.amplitude_scale,
     ]
 

@@ -96,7 +96,7 @@ from .newton import Evaluation, newton
 from ..problems.parsing import parse_float
 from ..problems.system import UnilateralSystem
 from .results import NNMResult, _repetitions
-from .sensitivity import _check_epsilon, _integrate
+from .sensitivity import _check_epsilon, _map_over
 
 __all__ = ["NNMShooting", "nnm_energy"]
 
@@ -374,26 +374,26 @@ class NNMShooting:
             return {"success": False, "message": f"the iterate left the admissible set (T = {period:.6g})"}
         horizon = 0.5 * period if self.formulation == "symmetric" else period
         self.flow_evaluations += 1
-        trajectory = _integrate(self._flow(epsilon), x0, v0, horizon, sensitivity=jacobian, d_epsilon=d_epsilon)
-        if not trajectory.success:
-            return {"success": False, "message": trajectory.message}
+        trajectory = _map_over(self._flow(epsilon), x0, v0, horizon, sensitivity=jacobian, d_epsilon=d_epsilon)
+        if isinstance(trajectory, str):
+            return {"success": False, "message": trajectory}
         amp_value, amp_x, amp_v, amp_eps = self._amplitude_row(x0, v0, epsilon, amplitude)
         xs, vs, As = self.position_scale, self.velocity_scale, self.amplitude_scale
         if self.formulation == "symmetric":
-            residual = np.r_[trajectory.velocity / vs, amp_value / As]
+            residual = np.r_[trajectory.state[n:] / vs, amp_value / As]
         else:
             residual = np.r_[
-                (trajectory.position - x0) / xs,
-                (trajectory.velocity - v0) / vs,
+                (trajectory.state[:n] - x0) / xs,
+                (trajectory.state[n:] - v0) / vs,
                 amp_value / As,
                 float(self.modal_row @ v0) / vs,
             ]
-        out: dict[str, Any] = {"success": True, "message": "", "residual": residual, "n_switches": trajectory.n_switches,
-                               "end_position": trajectory.position, "end_velocity": trajectory.velocity}
+        out: dict[str, Any] = {"success": True, "message": "", "residual": residual, "n_switches": trajectory.counters["switches"],
+                               "end_position": trajectory.state[:n], "end_velocity": trajectory.state[n:]}
         if jacobian or d_epsilon:
-            acceleration = self.system.acceleration(trajectory.position, epsilon)
+            acceleration = self.system.acceleration(trajectory.state[:n], epsilon)
         if jacobian:
-            S = trajectory.sensitivity
+            S = trajectory.d_state
             if self.formulation == "symmetric":
                 J = np.zeros((n + 1, n + 1))
                 J[:n, :n] = S[n:, :n] / vs
@@ -404,7 +404,7 @@ class NNMShooting:
                 J = np.zeros((2 * n + 2, 2 * n + 1))
                 J[:n, :n] = (S[:n, :n] - identity) / xs
                 J[:n, n:2 * n] = S[:n, n:] / xs
-                J[:n, 2 * n] = trajectory.velocity / xs
+                J[:n, 2 * n] = trajectory.state[n:] / xs
                 J[n:2 * n, :n] = S[n:, :n] / vs
                 J[n:2 * n, n:2 * n] = (S[n:, n:] - identity) / vs
                 J[n:2 * n, 2 * n] = acceleration / vs
