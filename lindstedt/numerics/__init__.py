@@ -39,20 +39,25 @@ Forced and damped responses
     :func:`forced_flow` picks the exact one where it applies.  :func:`forced_periodic_orbit` shoots one
     periodic response (:class:`ForcedOrbit`: amplitudes, first harmonics, Floquet multipliers);
     :func:`frequency_response` follows a branch in Ω or in the load by pseudo-arclength continuation through
-    folds and locates folds, period doublings and Neimark–Sacker points (:class:`FrequencyResponse`,
+    folds and locates folds, branch points, period doublings and Neimark–Sacker points (:class:`FrequencyResponse`,
     :class:`Bifurcation`); :func:`switch_period_doubling` continues the period-2 branch;
     :func:`frequency_response_sweep` runs families on any executor.
 
 The systems themselves are :class:`lindstedt.UnilateralSystem`.
 
 Layout (the pipeline, in order)
-    the exact flow (:class:`ExactFlow`, in :mod:`lindstedt.numerics.flow`; switch search in ``switching``; DOP853 for smooth f in ``smooth``) →
-    :mod:`~lindstedt.numerics.sensitivity` (its exact derivatives in the initial
-    state and in ε) → :mod:`~lindstedt.numerics.shooting` (the shooting
-    residual and Jacobian, Newton, :func:`nnm_point`, :func:`nnm_energy`) →
-    :mod:`~lindstedt.numerics.continuation` (one continuation driver with the
-    methods "arclength", "natural" and "seed", and :func:`nnm_sweep`);
-    :mod:`~lindstedt.numerics.results` holds the result types and
+    the flows, each behind the one :class:`PeriodMap` protocol: the exact free flow (:class:`ExactFlow`, in
+    :mod:`~lindstedt.numerics.flow`, its results in ``flow_results``; switch search in ``switching``; the
+    ε-derivative in :mod:`~lindstedt.numerics.sensitivity`; DOP853 for smooth f in ``smooth``), the exact forced
+    flow (``forced_flow``) and the DOP853 forced flow (``forced_smooth``) →
+    the periodic-orbit core: one damped Newton (:mod:`~lindstedt.numerics.newton`) and one continuation driver
+    with the test functions of folds, branch points, period doublings and Neimark–Sacker points
+    (:mod:`~lindstedt.numerics.arclength`) →
+    the orbit problems on it: NNM shooting (:mod:`~lindstedt.numerics.shooting`: residual, Jacobian,
+    :func:`nnm_energy`), NNM branches (``nnm_branch``: the steppers "arclength", "natural", "seed") and their
+    entry points (:mod:`~lindstedt.numerics.continuation`: :func:`nnm_point`, :func:`continue_nnm`,
+    :func:`nnm_sweep`); forced orbits (``forced_orbit``) and branches (:mod:`~lindstedt.numerics.forced_response`);
+    :mod:`~lindstedt.numerics.results` and ``forced_results`` hold the result types and
     :mod:`~lindstedt.numerics.examples` the seed's example system.
 
 Examples

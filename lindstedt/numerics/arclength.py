@@ -22,7 +22,7 @@ the energy or the modal amplitude) or the fixed point ``Π(z; λ) − z`` of a f
   circle; not defined on conservative branches, whose multipliers come in pairs μ, 1/μ).
 
 A stepper specialises the driver through a few hooks (the branch's residual and scales, the verification of a
-point, the landing solve, the branch's result): :class:`NNMArclength <lindstedt.numerics.nnm_branch>` adds the
+point, the landing solve, the branch's result): the NNM stepper of :mod:`lindstedt.numerics.nnm_branch` adds the
 resonance-tongue jumps and contact-change refinement of free NNM branches, the forced stepper of
 :mod:`lindstedt.numerics.forced_response` the growth rescaling and the rejoining of a period-2k branch.
 

@@ -1,46 +1,35 @@
-"""Continuation of NNMs of  M X'' + K X + ε W (A X − b)_+ = 0 : one driver, three methods, and sweeps.
+"""NNMs of  M X'' + K X + ε W (A X − b)_+ = 0 : one point, a branch, a sweep (the entry points).
 
 :func:`continue_nnm` follows the NNM of one mode in a parameter λ — ε, the
 energy or the modal amplitude (:mod:`lindstedt.numerics.shooting` gives the
 residual ``G(z; λ) = 0`` in the shooting unknowns z and its exact Jacobian).
-One driver runs every method: it solves the first point (Newton from the
-linear mode, then from the strained-coordinates expansion :func:`lindstedt.nnm`,
-then by continuation in ε from where the expansion holds — the route of
-:func:`~lindstedt.numerics.nnm_point`), then asks the method for
-the next point, counts rejected steps, reports progress
-(:class:`~lindstedt.numerics.ContinuationProgress`) and assembles the
-:class:`~lindstedt.numerics.NNMBranch` (folds, stability and contact changes,
-resonance jumps).  The methods (``method=``, a small registry) differ only in
-how they step:
+It solves the first point by :func:`nnm_point`'s route (Newton from the linear
+mode, then from the strained-coordinates expansion :func:`lindstedt.nnm`, then
+by continuation in ε from where the expansion holds) and hands it to the one
+continuation driver of the periodic-orbit core
+(:func:`lindstedt.numerics.arclength.drive`) with the stepper of the method
+(``method=``; :mod:`lindstedt.numerics.nnm_branch`):
 
 ``"arclength"`` — pseudo-arclength continuation
-    Unknowns ``w = (z, λ)``; predictor ``w + h t`` along the unit tangent t, the
-    null vector of the exact augmented Jacobian ``[∂G/∂z, ∂G/∂λ]`` oriented as
-    the previous one; corrector: Newton on ``[G(w); tᵀ(w − w_k) − h] = 0`` in
-    scaled variables.  Step control on the corrector's first correction (the
-    predictor's error), its iterations, contact changes and the turn of the
-    tangent; the Floquet multipliers of every point give the stability along
-    the branch; the last point is solved at exactly ``λ = stop``.
-    Contact changes: where the springs switching along the orbit change (a
-    spring grazes the orbit — at the contact onset the backbone has a kink
-    and a steep part, dω/dλ jumps), a step across is refined to 1/8 of the
-    initial step and the branch is followed through the corner and the steep
-    part (the tangent may turn and its λ-component drop there: that is not a
-    resonance); the stop reason names each contact change.
-    Internal resonances: where ``λ_k ≈ n ω`` the branch of mode j meets a
-    resonance tongue of mode k — the arc turns vertical (λ stops advancing)
-    *towards mode k* and climbing it stalls the continuation (the 20-dof chain
-    with three springs did so at ε ≈ 0.011 after 330 points).  When the
-    tangent's λ-component collapses, mode k dominates it and the period is locked
-    (its component of the tangent small), the method *jumps*:
-    it solves at fixed λ further and further beyond (predictor: the last
-    regular tangent) and lands on the first regular point of mode j
-    (``NNMBranch.jumps``, the stop reason names what each jump crossed).  If no
-    landing succeeds, the turn is a fold of mode j itself and is followed,
-    until the branch leaves mode j; a turn that stays in mode j (a steep part
-    of the backbone, or a fold) is followed from the start.  A step that would
-    shrink below ``min_step`` is rescued once by the same jump; the branch
-    never ends without a reason naming where and why.
+    The core's stepper (:class:`lindstedt.numerics.arclength.Arclength`):
+    predictor ``w + h t`` along the unit tangent t, the null vector of the
+    exact augmented Jacobian ``[∂G/∂z, ∂G/∂λ]`` oriented as the previous one;
+    corrector: the core's Newton on ``[G(w); tᵀ(w − w_k) − h] = 0`` in scaled
+    variables; step control on the corrector's first correction and its
+    iterations; the Floquet multipliers of every point give the stability, and
+    the folds, branch points and period doublings are located on the branch
+    (``NNMBranch.bifurcations``) by the same test functions as on forced
+    branches; the last point is solved at exactly ``λ = stop``.  What free
+    NNM branches add: a step across which the springs switching along the
+    orbit change is refined to 1/8 of the initial step (the backbone has a
+    corner there, a spring grazes the orbit); where the branch turns vertical
+    towards another mode k (an internal-resonance tongue, ``λ_k ≈ n ω``, the
+    period locked), a parameter jump across it to the next regular point of
+    mode j (``NNMBranch.jumps``; the 20-dof chain with three springs would
+    otherwise stall at ε ≈ 0.011); where no jump lands, the turn is followed as
+    a fold until the branch leaves mode j.  A step that would shrink below
+    ``min_step`` is rescued once by the same jump; the branch never ends
+    without a reason naming where and why.
 ``"natural"`` — natural-parameter continuation
     λ steps with the secant-extrapolated previous solution as guess and Newton
     at fixed λ, the step halved on failure.
@@ -52,8 +41,8 @@ how they step:
     orbit — hybr still converges to some point of it because the system is
     consistent).
 
-:func:`nnm_sweep` solves independent points (:func:`~lindstedt.numerics.nnm_point`
-at each parameter value, optionally on an executor), without continuation.
+:func:`nnm_sweep` solves independent points (:func:`nnm_point` at each
+parameter value, optionally on an executor), without continuation.
 
 Examples
 --------
