@@ -25,6 +25,12 @@ Contact Fourier kernel of a unilateral spring (``κ = b/|a0|``, ``β = arccos κ
     converging series they build (:func:`series_sum`,
     :func:`sum_cosine_series_at`, each a :class:`SeriesEstimate` ``(value, error_estimate)``).
 
+Closed forms in the contact angles
+    :func:`in_contact_angles` rewrites the coefficients of a piecewise expansion with
+    a symbolic gap in ``κ = b/a0``, ``β = arccos κ``, ``σ = sqrt(1 − κ²)`` (reduced
+    modulo ``σ² = 1 − κ²``): an identity, returned with the definitions as a
+    :class:`ContactAngleForm` that any text or LaTeX output prints.
+
 Analytic branches
     ``Σ c s^m cos(j s) + d s^m sin(j s)`` on one contact state (module
     :mod:`lindstedt.algebra.branch`): the representation the piecewise engines
@@ -63,6 +69,7 @@ from .fourier import (
 from .fourier_float import contact_angle_float, contact_ramp_coefficients_float, contact_step_coefficients_float
 from .series import SeriesEstimate, series_sum, sum_cosine_series_at
 from .cosine import CosineSeries, SecularTermError, SineSeries, solve_harmonic_oscillator
+from .contact_angles import ContactAngleForm, in_contact_angles
 
 __all__ = [
     "CosineSeries",
@@ -82,4 +89,6 @@ __all__ = [
     "SeriesEstimate",
     "series_sum",
     "sum_cosine_series_at",
+    "ContactAngleForm",
+    "in_contact_angles",
 ]

@@ -26,7 +26,7 @@ import sympy
 
 from .._errors import ParameterError, ProblemError
 from .._precision import locked, locked_methods
-from .oscillator import Oscillator
+from .oscillator import Oscillator, terms_text
 from .parsing import parse_real
 from .matrices import _exact_matrix, _exact_scalar, _float_array
 from .system import UnilateralSystem
@@ -196,13 +196,12 @@ class ForcedOscillator:
 
         Examples
         --------
-        >>> ForcedOscillator("u**3", omega0=1, zeta="1/50").describe()
-        "u'' + 2*(1/50)*1*u' + 1**2*u + eps*(u**3) = eps*1*cos(Omega*t)"
+        >>> ForcedOscillator("u**3", omega0=1, zeta="1/100").describe()
+        "u'' + u'/50 + u + eps*(u**3) = eps*cos(Omega*t)"
         """
-        return (
-            f"u'' + 2*({self.zeta})*{self.omega0}*u' + {self.omega0}**2*u + eps*({self.nonlinearity}) "
-            f"= eps*{self.forcing}*cos(Omega*t)"
-        )
+        u, velocity, acceleration, eps, omega, t = sympy.symbols("u u' u'' eps Omega t")
+        left = terms_text(acceleration, 2 * self.zeta * self.omega0 * velocity, self.omega0**2 * u)
+        return f"{left} + eps*({self.nonlinearity}) = {terms_text(eps * self.forcing * sympy.cos(omega * t))}"
 
 
 def _symmetric_positive_semidefinite(C: np.ndarray, C_exact: sympy.ImmutableMatrix) -> None:

@@ -644,22 +644,48 @@ class Oscillator:
         return substitution
 
     def describe(self) -> str:
-        """One-line human description of the problem."""
+        """One-line human description of the problem, its terms simplified.
+
+        Examples
+        --------
+        >>> Oscillator("u**3", a0=1, omega0=2, a1="-1/10").describe()
+        "u'' + 4*u + eps*(u**3) = 0, u(0) = 1 - eps/10 [initial]"
+        """
         params = ", ".join(f"{symbol} = {value}" for symbol, value in self.params if value != symbol)
         symbolic = ", ".join(str(symbol) for symbol in self.symbolic_parameters)
-        squared = self.omega0**2
-        stiffness = f"({sympy.sstr(squared)})" if isinstance(squared, sympy.Add) else sympy.sstr(squared)
-        stiffness_term = "u" if squared == 1 else f"{stiffness}*u"
+        equation = f"{terms_text(_ACCELERATION, self.omega0**2 * DISPLACEMENT)} + eps*({self.f}) = 0"
         if self.has_initial_velocity:
-            text = (
-                f"u'' + {stiffness_term} + eps*({self.f}) = 0, u(0) = {self.u0}, u'(0) = {self.v0} "
-                f"[turning point a0 = {self.a0} + O(eps)]"
-            )
+            text = f"{equation}, u(0) = {self.u0}, u'(0) = {self.v0} [turning point a0 = {self.a0} + O(eps)]"
         else:
-            release = f"{self.a0}" if self.a1 == 0 else f"{self.a0} + eps*({self.a1})"
-            text = f"u'' + {stiffness_term} + eps*({self.f}) = 0, u(0) = {release} [{self.normalization}]"
+            text = f"{equation}, u(0) = {terms_text(self.a0, _EPS * self.a1)} [{self.normalization}]"
         if params:
             text += f"; {params}"
         if symbolic:
             text += f"; symbolic: {symbolic}"
         return text
+
+
+_EPS, _ACCELERATION = sympy.Symbol("eps"), sympy.Symbol("u''")
+
+
+def terms_text(*terms: sympy.Expr) -> str:
+    """The sum of ``terms`` in their order, each printed simplified by sympy, zero terms left out: ``u'' + u'/50 + u``.
+
+    Examples
+    --------
+    >>> u, v = sympy.symbols("u u'")
+    >>> terms_text(sympy.Symbol("u''"), 2 * sympy.Rational(1, 100) * 1 * v, 1**2 * u, -sympy.Rational(1, 3) * u**3)
+    "u'' + u'/50 + u - u**3/3"
+    """
+    text = ""
+    for term in terms:
+        if term == 0:
+            continue
+        printed = sympy.sstr(term)
+        if not text:
+            text = printed
+        elif printed.startswith("-"):
+            text += " - " + printed[1:]
+        else:
+            text += " + " + printed
+    return text or "0"
