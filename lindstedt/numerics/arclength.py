@@ -14,6 +14,7 @@ the energy or the modal amplitude) or the fixed point ``Π(z; λ) − z`` of a f
   ``[G(w); tᵀ(w − w_k)/D − h] = 0``; step control on the corrector's first correction (the predictor's error,
   aimed at ``predictor_error``) and its iterations; a turn of the tangent beyond ``max_turn`` is rejected;
   a step across the end of the range lands exactly on it by a solve at fixed λ;
+* branch switching (:meth:`Arclength.branch_off`): the first point of another branch through a special point;
 * the test functions of every branch (:func:`bifurcation_tests`), located by regula falsi (Illinois) along the
   arclength (:meth:`Arclength.locate`): a **fold** (the λ-component of the tangent changes sign), a **branch
   point** (``det [∂G/∂w; tᵀ]`` changes sign while the tangent does not turn back), a **period doubling**
@@ -404,6 +405,17 @@ class Arclength(Stepper):
         inner = outcome.last.data
         return bifurcation_tests(self.multipliers(point, inner), unit, inner.jacobian * scales[None, :],
                                  conservative=self.conservative)
+
+    def branch_off(self, w_star: np.ndarray, direction: np.ndarray, h: float) -> NewtonOutcome:
+        """Branch switching: the first point of another branch through the special point ``w_star``.
+
+        Predictor ``w* + h D d`` along the unit direction d (scaled variables) of the other branch — the
+        eigenvector of the multiplier −1 at a period doubling of the doubled-period map, the second null vector
+        at a branch point — and corrector in the plane ⟂ d: it lands on the other branch on either side of the
+        pitchfork.  The new branch's first tangent is then oriented along d (:attr:`hint`).
+        """
+        self.hint = direction
+        return self.corrector(w_star, self.scales_of(w_star, None), direction, h)
 
     def start_at(self, w: np.ndarray, point: Any, hint: np.ndarray | None = None) -> str | None:
         """Set the branch's first point w (its tangent oriented along ``hint`` or towards stop)."""

@@ -445,8 +445,7 @@ def switch_period_doubling(response: FrequencyResponse, index: int = 0, *, stop:
     t0 /= np.linalg.norm(t0)
     stepper = _ForcedBranch(flow, parameter, fixed, 2 * k, D_old, merged, start=lam_star, stop=None, bounds=(lo, hi),
                             rejoin=True, direction=1.0)
-    stepper.w, stepper.scales, stepper.tangent = np.r_[point.state, lam_star], D_old, t0
-    outcome = stepper.corrector(stepper.w, D_old, t0, amplitude_step)
+    outcome = stepper.branch_off(np.r_[point.state, lam_star], t0, amplitude_step)
     if not outcome.success:
         return FrequencyResponse(False, f"no period-{2 * k} orbit next to the period doubling at {parameter} = "
                                  f"{lam_star:.8g}: {outcome.message}", parameter, 2 * k, getattr(flow, "epsilon", None),
@@ -458,7 +457,7 @@ def switch_period_doubling(response: FrequencyResponse, index: int = 0, *, stop:
     first = replace(first, newton_iterations=outcome.iterations, flow_evaluations=0, steps=0, evaluations=0)
     stepper.first_message = f"switched at the period doubling {parameter} = {lam_star:.10g}"
     lam1 = float(w1[-1])
-    stepper.direction, stepper.hint = (1.0 if lam1 >= lam_star else -1.0), t0
+    stepper.direction = 1.0 if lam1 >= lam_star else -1.0
     return drive(stepper, first, lam1, merged["max_points"], iterations=outcome.iterations, started=started)
 
 
