@@ -36,6 +36,7 @@ import sympy
 
 import lindstedt
 from lindstedt import references
+from lindstedt.algebra import in_contact_angles
 
 
 def _helper():
@@ -60,33 +61,14 @@ BETA = sympy.Symbol("beta", positive=True)
 SIGMA = sympy.Symbol("sigma", positive=True)
 
 
-def in_kappa(expression: sympy.Expr, b: sympy.Symbol) -> sympy.Expr:
-    """Rewrite omega_k(b) (a0 = 1) in kappa, beta = acos(kappa), sigma = sqrt(1 - kappa^2), reduced modulo sigma^2 = 1 - kappa^2."""
-    one_minus = 1 - KAPPA**2
-    value = expression.subs(b, KAPPA)
-    value = value.replace(lambda x: isinstance(x, sympy.acos) and x.args[0] == KAPPA, lambda x: BETA)
-    value = value.replace(
-        lambda x: x.is_Pow and sympy.expand(x.base - one_minus) == 0 and (2 * x.exp).is_integer,
-        lambda x: SIGMA ** int(2 * x.exp),
-    )
-    numerator, denominator = sympy.fraction(sympy.together(value))
-    power = sympy.degree(denominator, SIGMA)
-    numerator, denominator = sympy.expand(numerator * SIGMA**power), sympy.expand(denominator * SIGMA**power)
-    relation = SIGMA**2 - one_minus
-    numerator = sympy.rem(numerator, relation, SIGMA)
-    denominator = sympy.rem(denominator, relation, SIGMA)
-    numerator, denominator = sympy.fraction(sympy.cancel(numerator / denominator))
-    numerator = sympy.collect(sympy.expand(numerator), [BETA, SIGMA], sympy.factor)
-    numerator = numerator.subs((KAPPA - 1) * (KAPPA + 1), -(SIGMA**2))
-    return numerator / sympy.factor(denominator)
-
-
 @functools.cache
 def closed_forms() -> tuple[sympy.Expr, sympy.Expr]:
-    """(omega_1, omega_2) of u'' + omega0^2 u + eps (u - b)_+ = 0, u(0) = a0 > 0, as functions of kappa = b/a0 (|kappa| < 1)."""
+    """(omega_1, omega_2) of u'' + omega0^2 u + eps (u - b)_+ = 0, u(0) = a0 > 0, as functions of kappa = b/a0 (|kappa| < 1):
+    the exact omega_k(b) at a0 = 1 in kappa, beta = acos(kappa), sigma = sqrt(1 - kappa^2)
+    (:func:`lindstedt.algebra.in_contact_angles`, reduced modulo sigma^2 = 1 - kappa^2)."""
     expansion = lindstedt.expand("Max(0, u - b)", order=2, a0=1, params={"b": None})
-    b = next(symbol for symbol in expansion.problem.free_symbols if symbol.name == "b")
-    return in_kappa(expansion.omega[1], b), in_kappa(expansion.omega[2], b)
+    form = in_contact_angles(expansion.omega[1:])
+    return form.forms
 
 
 def at_kappa(form: sympy.Expr, kappa: sympy.Expr) -> sympy.Expr:
