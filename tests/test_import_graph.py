@@ -1,4 +1,4 @@
-"""The import graph of the package has no circle (issue 24: a house without circles).
+"""The import graph of the package has no circle, and no module is over 800 lines (issue 24: a house without circles).
 
 Every ``import`` and ``from … import`` of every module of ``lindstedt/`` — at module level and inside functions
 alike (a deferred import is still a dependency) — is read from the source with ``ast``, and the strongly connected
@@ -122,3 +122,14 @@ def test_results_import_no_export():
     for name, targets in graph.items():
         if name.startswith("lindstedt.results"):
             assert not [target for target in targets if target.startswith("lindstedt.export")], name
+
+
+#: no module of the package is longer than this (issue 24: a module per concept)
+MAX_MODULE_LINES = 800
+
+
+def test_no_module_is_over_the_size_limit():
+    sizes = {path.relative_to(PACKAGE).as_posix(): len(path.read_text(encoding="utf-8").splitlines())
+             for path in PACKAGE.rglob("*.py")}
+    assert len(sizes) > 50  # the walk sees the package
+    assert {name: lines for name, lines in sizes.items() if lines > MAX_MODULE_LINES} == {}
