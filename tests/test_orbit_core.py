@@ -107,3 +107,15 @@ def test_one_newton_and_one_pseudo_arclength_driver_in_the_package():
                 for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
                 if isinstance(node, ast.ClassDef) and any(getattr(base, "id", "") == "Arclength" for base in node.bases)}
     assert steppers == {"forced_response.py", "nnm_branch.py"}  # forced and free branches: one stepper each
+
+
+def test_the_special_points_of_a_free_branch_are_located_when_read_and_survive_pickling():
+    import pickle
+
+    branch = continue_nnm(_decoupled_system(), 1, modal_amplitude=1.0, start=0.0, stop=1.0)
+    flows = branch.flow_evaluations
+    copy = pickle.loads(pickle.dumps(branch))
+    located = [(b.kind, b.forcing_scale, b.frequency) for b in branch.bifurcations]
+    assert located == [(b.kind, b.forcing_scale, b.frequency) for b in copy.bifurcations]
+    assert abs(located[0][1] - BRANCH_POINT) <= 1e-9
+    assert branch.flow_evaluations == flows  # the continuation's counters are its own

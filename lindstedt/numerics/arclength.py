@@ -51,11 +51,15 @@ from .._errors import BudgetError, Cancelled
 from ..limits import checkpoint
 from .newton import Evaluation, NewtonOutcome, newton
 
-__all__ = ["Arclength", "Attempt", "Stepper", "drive", "locate_kind", "step_factor", "tangent", "bifurcation_tests",
+__all__ = ["Arclength", "Attempt", "Bracket", "Stepper", "drive", "locate_kind", "step_factor", "tangent", "bifurcation_tests",
            "KINDS"]
 
 #: the special points every branch is searched for, in the order they are reported
 KINDS = ("fold", "branch-point", "period-doubling", "neimark-sacker")
+#: a location whose test is still above this share of its values at the step's ends after this many probes, or
+#: above the second share when bracketed, found a jump of the test, not a zero (a smooth zero is approached
+#: superlinearly: ~1e-7 of them when bracketed to 1e-9 of a step)
+_JUMP_PROBES, _JUMP_RATIO, _ZERO_RATIO = 8, 1e-3, 1e-5
 #: the kinds whose test functions read the Floquet multipliers
 _MULTIPLIER_KINDS = ("period-doubling", "neimark-sacker")
 
@@ -105,6 +109,7 @@ class Stepper(ABC):
         self.h_min = abs(min_step) if min_step else self.step / 2.0**max_halvings
         self.h_max = abs(max_step) if max_step else 4.0 * self.step
         self.bifurcations: list[Any] = []
+        self.brackets: list[Bracket] = []
 
     def begin(self, first: Any, value: float) -> str | None:
         return None
@@ -245,11 +250,14 @@ def locate_kind(kind: str, f0: float, f1: float, h: float, probe: Callable[[floa
 
     ``probe(σ)`` corrects the predictor at σ and returns ``(test value, located data)``, None on failure.
     Returns the data and the test value at the last probe, an end of a bracket of the zero at most ``tol`` wide
-    (or after ``max_iterations`` probes), or None.
+    (or after ``max_iterations`` probes), or None — also when the test does not go to zero but jumps (still
+    above ``_JUMP_RATIO`` of its values at the ends after ``_JUMP_PROBES`` probes, or above ``_ZERO_RATIO`` of
+    them at the end: the test is discontinuous where the residual is not smooth, e.g. at a grazing).
     """
     a, fa, b, fb = 0.0, f0, h, f1
+    scale = max(abs(f0), abs(f1))
     found = None
-    for _ in range(max_iterations):
+    for probes in range(1, max_iterations + 1):
         c = b - fb * (b - a) / (fb - fa)
         if not (min(a, b) < c < max(a, b)):
             c = (a + b) / 2
@@ -260,6 +268,8 @@ def locate_kind(kind: str, f0: float, f1: float, h: float, probe: Callable[[floa
         found = (data, fc)
         if fc == 0:
             break
+        if probes >= _JUMP_PROBES and abs(fc) > _JUMP_RATIO * scale:
+            return None  # the test jumps across the step (the residual is not smooth there): not a zero
         if fc * fb < 0:
             a, fa = b, fb
         else:
@@ -267,6 +277,8 @@ def locate_kind(kind: str, f0: float, f1: float, h: float, probe: Callable[[floa
         b, fb = c, fc
         if abs(b - a) <= tol:
             break
+    if found is None or abs(found[1]) > _ZERO_RATIO * scale:
+        return None  # not brought near zero: a jump of the test, not a special point
     return found
 
 
@@ -286,6 +298,24 @@ def changes(before: dict[str, float], after: dict[str, float], *, turned_back: b
     return kinds
 
 
+@dataclass(frozen=True)
+class Bracket:
+    """A sign change of the test function of ``kind`` over one step, from the base point (``w``, ``scales``,
+    ``unit`` tangent, the verified ``point``) over the arclength ``h``: what locating it needs, kept by steppers
+    that locate lazily (:attr:`Arclength.lazy_location`)."""
+
+    kind: str
+    index: int
+    f0: float
+    f1: float
+    h: float
+    w: np.ndarray
+    scales: np.ndarray
+    unit: np.ndarray
+    point: Any
+    within: float | None = None
+
+
 # --------------------------------------------------------------------------- #
 # the pseudo-arclength stepper
 # --------------------------------------------------------------------------- #
@@ -303,6 +333,8 @@ class Arclength(Stepper):
     """
 
     name = "arclength"
+    #: keep the sign changes as :class:`Bracket` (``self.brackets``) to be located on demand (:meth:`resolve`)
+    lazy_location = False
     predictor_error = 2e-3
     max_turn = 0.9
     step_tol: float | None = None
@@ -374,8 +406,8 @@ class Arclength(Stepper):
 
     # ------------------------------------------------------------ machinery
     def corrector(self, base: np.ndarray, scales: np.ndarray, unit: np.ndarray, sigma: float, *,
-                  locating: bool = False) -> NewtonOutcome:
-        """Newton on ``[G(w); tᵀ(w − base)/D − σ] = 0`` from the predictor ``base + σ D t``.
+                  locating: bool = False, start: np.ndarray | None = None) -> NewtonOutcome:
+        """Newton on ``[G(w); tᵀ(w − base)/D − σ] = 0`` from the predictor ``base + σ D t`` (or from ``start``).
 
         ``locating``: a probe of a special point — converged on the residual alone (the last evaluation, whose
         test functions are read, is then at the returned point) and through a branch point, where the augmented
@@ -389,7 +421,7 @@ class Arclength(Stepper):
             return Evaluation(True, "", np.r_[inner.residual, constraint],
                               np.vstack([inner.jacobian, unit / scales]), inner.step_bound, inner, inner.singular)
 
-        return newton(augmented, base + sigma * unit * scales, scales, tol=self.tol,
+        return newton(augmented, base + sigma * unit * scales if start is None else start, scales, tol=self.tol,
                       max_iterations=self.max_iterations, step_tol=None if locating else self.step_tol,
                       allow_singular=locating)
 
@@ -497,24 +529,39 @@ class Arclength(Stepper):
         for kind in changes(before, after, turned_back=turned_back):
             if not smooth and kind != "fold":
                 continue
-            found = self.locate(kind, before[kind], after[kind], h)
-            if found is None:
+            bracket = Bracket(kind, index, before[kind], after[kind], h, self.w, self.scales, self.tangent, self.last,
+                              within)
+            if self.lazy_location:
+                self.brackets.append(bracket)
                 continue
-            (w, point, evaluation), test = found
-            if not self.admissible(float(w[-1]), within):
-                continue
-            record = self.bifurcation(kind, w, point, evaluation, test, index)
+            record = self.resolve(bracket)
             if record is not None:
                 self.bifurcations.append(record)
+
+    def resolve(self, bracket: Bracket) -> Any:
+        """Locate the special point of a :class:`Bracket` (the stepper's base state is set to the bracket's);
+        its record, or None where the test jumps instead of vanishing or the point lies outside the range."""
+        self.w, self.scales, self.tangent, self.last = bracket.w, bracket.scales, bracket.unit, bracket.point
+        found = self.locate(bracket.kind, bracket.f0, bracket.f1, bracket.h)
+        if found is None:
+            return None
+        (w, point, evaluation), test = found
+        if not self.admissible(float(w[-1]), bracket.within):
+            return None
+        return self.bifurcation(bracket.kind, w, point, evaluation, test, bracket.index)
 
     def locate(self, kind: str, f0: float, f1: float, h: float) -> tuple[tuple[np.ndarray, Any, Evaluation], float] | None:
         """The special point of ``kind`` on the step from self.w: regula falsi on its test along the arclength."""
         base, scales, unit = self.w, self.scales, self.tangent
+        known: list[tuple[float, np.ndarray]] = [(0.0, base)]  # corrected points of this step: warm starts
 
         def probe(sigma: float) -> tuple[float, Any] | None:
-            outcome = self.corrector(base, scales, unit, sigma, locating=True)
+            near, w_near = min(known, key=lambda item: abs(item[0] - sigma))
+            outcome = self.corrector(base, scales, unit, sigma, locating=True,
+                                     start=w_near + (sigma - near) * unit * scales)
             if not outcome.success:
                 return None
+            known.append((sigma, outcome.unknowns))
             inner = outcome.last.data
             point = None
             if self.multipliers_need_point and kind in _MULTIPLIER_KINDS:  # the others need no verified orbit

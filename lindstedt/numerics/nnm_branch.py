@@ -138,8 +138,32 @@ class _NNMStepper(Stepper):
             points=tuple(points), parameter_values=np.array(values, dtype=float), folds=folds,
             stability_changes=stability, contact_changes=contact, flow_evaluations=self.problem.flow_evaluations,
             newton_iterations=iterations, rejected_steps=rejected, wall_time=time.perf_counter() - started,
-            system=self.problem.system, jumps=tuple(self.jumps), bifurcations=tuple(self.bifurcations),
+            system=self.problem.system, jumps=tuple(self.jumps),
+            _locator=_Locator(self.problem, self.path, self.start, self.stop, self.options, tuple(self.brackets))
+            if self.brackets else None,
         )
+
+
+@dataclass(frozen=True)
+class _Locator:
+    """The special points bracketed along an NNM branch, located on demand (``NNMBranch.bifurcations``).
+
+    Holds what a stepper needs to run the core's location again from each bracket's base point (the problem,
+    the parameter, the solver options); picklable (the problem drops its flow caches).
+    """
+
+    problem: NNMShooting
+    path: _Path
+    start: float
+    stop: float
+    options: dict[str, Any]
+    brackets: tuple[Any, ...]
+
+    def __call__(self) -> tuple[Bifurcation, ...]:
+        stepper = _NNMArclength(self.problem, self.path, self.start, self.stop, step=None, min_step=None,
+                                max_step=None, max_halvings=12, options=self.options)
+        records = (stepper.resolve(bracket) for bracket in self.brackets)
+        return tuple(record for record in records if record is not None)
 
 
 # --------------------------------------------------------------------------- #
@@ -255,7 +279,7 @@ class _NNMArclength(_NNMStepper, Arclength):
 
     name = "arclength"
     conservative = True
-    multipliers_need_point = True
+    lazy_location = True  # located when NNMBranch.bifurcations is first read (lazy work: a continuation needs none)
     step_tol = _STEP_TOL
     #: reject a first point whose tangent's λ-component is below this (None: no check)
     minimum_start_slope: float | None = None
@@ -270,6 +294,7 @@ class _NNMArclength(_NNMStepper, Arclength):
         out = self.problem.evaluate(w[:-1], eps, amplitude=amplitude, d_epsilon=self.path.parameter == "epsilon")
         if not out["success"]:
             return Evaluation(False, out["message"])
+        out["unknowns"] = w
         return Evaluation(True, "", out["residual"], np.column_stack([out["jacobian"], self.path.derivative(out)]),
                           data=out)
 
@@ -294,8 +319,15 @@ class _NNMArclength(_NNMStepper, Arclength):
                                      amplitude=amplitude)
         return (result, "") if result.success else (None, result.message)
 
-    def multipliers(self, point: NNMResult, evaluation: Evaluation) -> np.ndarray | None:
-        return None if point is None else point.nontrivial_multipliers
+    def multipliers(self, point: NNMResult | None, evaluation: Evaluation) -> np.ndarray:
+        """The non-trivial multipliers from the evaluation's sensitivity (:meth:`NNMShooting.monodromy_of`): no
+        verification flow, so the special points are located on the corrector's evaluations alone."""
+        out = evaluation.data
+        w = out["unknowns"]
+        eps, _ = self.path.at(float(w[-1]))
+        x0, v0, _ = self.problem.split(w[:-1])
+        monodromy = self.problem.monodromy_of(out)
+        return self.problem.floquet(monodromy, np.r_[v0, self.problem.system.acceleration(x0, eps)])[1]
 
     def land(self, value: float, guess: np.ndarray) -> tuple[Any, int, str]:
         result = self.problem._solve(guess, *self.path.at(value), **self.options)

@@ -28,6 +28,7 @@ import numpy as np
 
 from ..render.display import format_number, format_vector, html_grid, html_table, labelled_repr
 from ..render.json import JsonExport, finite_float, to_jsonable
+from .._precision import cached_property, locked
 from .forced_results import Bifurcation
 
 __all__ = ["ContinuationProgress", "NNMBranch", "NNMResult", "to_dataframe"]
@@ -348,15 +349,6 @@ class NNMBranch(JsonExport):
         continuous arc; ``stop_reason`` says what each jump crossed.  Contact
         changes (``contact_changes``, e.g. the contact onset where the
         backbone turns steep) are followed, not jumped.
-    bifurcations : tuple of Bifurcation
-        The special points located on the branch (method "arclength") by the
-        same test functions as on forced branches
-        (:mod:`lindstedt.numerics.arclength`): folds, branch points and
-        period doublings (a non-trivial Floquet multiplier through −1); the
-        Neimark–Sacker test does not apply to these conservative orbits.  Not
-        searched across a contact change or a jump, where the residual is not
-        smooth.  ``frequency`` is ω, ``amplitude`` ``|X0|``, ``state``
-        ``(X0, X1)`` and ``forcing_scale`` the parameter value there.
 
     JSON schema ``lindstedt.nnm-branch/1`` (:meth:`to_json`; every point as
     its ``lindstedt.nnm-numeric/1`` dictionary).
@@ -379,7 +371,24 @@ class NNMBranch(JsonExport):
     wall_time: float
     system: Any = field(default=None, repr=False, compare=False)  # the UnilateralSystem it was computed for
     jumps: tuple[int, ...] = ()
-    bifurcations: tuple[Bifurcation, ...] = ()
+    #: the sign changes of the test functions met along the branch, located on demand (bifurcations)
+    _locator: Any = field(default=None, repr=False, compare=False, metadata={"export": False})
+
+    @cached_property
+    @locked  # the location runs the problem's flows again: one thread at a time
+    def bifurcations(self) -> tuple[Bifurcation, ...]:
+        """The special points of the branch (method "arclength"), located when first read.
+
+        Folds, branch points and period doublings (a non-trivial Floquet multiplier through −1) — found by the
+        same test functions and the same location as on forced branches (:mod:`lindstedt.numerics.arclength`);
+        the Neimark–Sacker test does not apply to these conservative orbits.  The continuation only notes where
+        a test changes sign (at no cost); reading this locates them (a few corrector solves each, counted in no
+        cost counter of the branch).  A sign change is not searched across a contact change or a jump (the
+        residual is not smooth there), and one whose test jumps instead of vanishing is not a special point.
+        ``frequency`` is ω, ``amplitude`` ``|X0|``, ``state`` ``(X0, X1)`` and ``forcing_scale`` the parameter
+        value there.
+        """
+        return self._locator() if self._locator is not None else ()
 
     def __len__(self) -> int:
         return len(self.points)
@@ -427,7 +436,8 @@ class NNMBranch(JsonExport):
             ("stability_changes", indices(self.stability_changes)),
             ("contact_changes", indices(self.contact_changes)),
             ("jumps", indices(self.jumps)),
-            ("bifurcations", ", ".join(f"{b.kind} at {b.forcing_scale:.6g}" for b in self.bifurcations) or "none"),
+            ("bifurcations", f"{len(self._locator.brackets) if self._locator is not None else 0} sign change(s) of "
+                             "the tests (.bifurcations locates them)"),
             ("flow_evaluations", str(self.flow_evaluations)),
             ("newton_iterations", str(self.newton_iterations)),
             ("rejected_steps", str(self.rejected_steps)),

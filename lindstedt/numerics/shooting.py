@@ -278,6 +278,12 @@ class NNMShooting:
         self.flow_evaluations = 0
         self.set_scales(epsilon=0.0)
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickled without its caches of flows and expansions (rebuilt on demand)."""
+        state = dict(self.__dict__)
+        state["_flows"], state["_expansions"] = {}, {}
+        return state
+
     # ------------------------------------------------------------------ scales
     def _guess_amplitude(self, epsilon: float, amplitude: _Amplitude | None = None) -> tuple[np.ndarray, float]:
         """Release position of the linear-mode guess and its modal amplitude."""
@@ -363,8 +369,8 @@ class NNMShooting:
 
         Returns a dict with ``residual`` (rows scaled), ``jacobian`` (rows
         scaled, columns = unscaled unknowns), ``d_epsilon`` (∂residual/∂ε),
-        ``d_level`` (∂residual/∂amplitude value), ``success``, ``message``,
-        ``n_switches``.
+        ``d_level`` (∂residual/∂amplitude value), ``sensitivity`` (``∂z(t)/∂z0``
+        over the flown time, T/2 or T), ``success``, ``message``, ``n_switches``.
         """
         epsilon = _check_epsilon(epsilon)
         amplitude = amplitude or self.amplitude
@@ -393,7 +399,7 @@ class NNMShooting:
         if jacobian or d_epsilon:
             acceleration = self.system.acceleration(trajectory.state[:n], epsilon)
         if jacobian:
-            S = trajectory.d_state
+            S = out["sensitivity"] = trajectory.d_state
             if self.formulation == "symmetric":
                 J = np.zeros((n + 1, n + 1))
                 J[:n, :n] = S[n:, :n] / vs
@@ -506,6 +512,21 @@ class NNMShooting:
         nontrivial = np.linalg.eigvals(Q.T @ monodromy @ Q) if size > 2 else np.array([], dtype=complex)
         nontrivial = nontrivial[np.argsort(np.abs(nontrivial - 1.0), kind="stable")]
         return trivial.astype(complex), nontrivial.astype(complex)
+
+    def monodromy_of(self, evaluation: dict[str, Any]) -> np.ndarray:
+        """The monodromy matrix from an evaluation's sensitivity, without another flow.
+
+        The full formulation flows over T: its sensitivity is the monodromy.  The symmetric one flows over T/2
+        from rest; the system is reversible (``R = diag(I, −I)``, ``φ_{−t} = R φ_t R``) and the orbit turns at
+        rest at T/2, so the second half-period is the first one reversed and ``Φ(T) = R S⁻¹ R S``,
+        S = ``∂z(T/2)/∂z0``.
+        """
+        S = evaluation["sensitivity"]
+        if self.formulation != "symmetric":
+            return S
+        n = self.n
+        reverse = np.r_[np.ones(n), -np.ones(n)]
+        return reverse[:, None] * np.linalg.solve(S, reverse[:, None] * S)
 
     def verify(self, unknowns: np.ndarray, epsilon: float, *, verify_tol: float, stability_tol: float,
                iterations: int, amplitude: _Amplitude | None = None, formulation_label: str | None = None,
