@@ -232,7 +232,7 @@ def _expand_output(arguments: argparse.Namespace, expansion: Any, progress: Prog
         if evaluated is not None:
             text += f"\nω(ε = {evaluated[0]!r}) = {evaluated[1]!r}"
         return text
-    text = _plain_expansion(expansion)
+    text = expansion.summary()
     if arguments.waveforms:
         text += "\n" + "\n".join(f"  v_{w.order}(s) = {w.to_expr()}" for w in expansion.waveforms)
     if evaluated is not None:
@@ -252,35 +252,6 @@ def _pretty_equation(name: Any, value: Any) -> str:
 
     left = sympy.Symbol(name) if isinstance(name, str) else name
     return _pretty(sympy.Eq(left, sympy.sympify(value, strict=True), evaluate=False))
-
-
-def _readable(expansion: Any) -> tuple[tuple, tuple, tuple, tuple]:
-    """(definitions, ω_k, A_k, φ_k) of an expansion as printed: closed forms in the contact angles
-    (κ = b/a0, β = acos κ, σ = sqrt(1 − κ²); :func:`lindstedt.algebra.in_contact_angles`) when they have any."""
-    from ..algebra import in_contact_angles
-
-    omega = tuple(expansion.omega)
-    series = (tuple(expansion.amplitude), tuple(expansion.phase)) if expansion.problem.has_initial_velocity else ((), ())
-    form = in_contact_angles(omega + series[0] + series[1])
-    forms = form.forms
-    return (form.definitions, forms[:len(omega)], forms[len(omega):len(omega) + len(series[0])],
-            forms[len(omega) + len(series[0]):])
-
-
-def _plain_expansion(expansion: Any) -> str:
-    """The ``--format plain`` output of ``expand``: the problem and ω_0..ω_N in Python syntax, one a line."""
-    definitions, omega, amplitude, phase = _readable(expansion)
-    lines = [expansion.problem.describe()]
-    if definitions:
-        lines.append("  where " + ", ".join(f"{symbol} = {value}" for symbol, value in definitions))
-    if not expansion.gauge.is_Symbol:
-        lines.append(f"  omega(eps) = sum_k omega_k {expansion.gauge}**k (grazing: not analytic in eps)")
-    lines += [f"  omega_{k} = {value}" for k, value in enumerate(omega)]
-    if expansion.problem.has_initial_velocity:
-        lines.append("  u(t) = v(omega*t + phi(eps); eps), released at the turning point A(eps) = v(0; eps) > 0")
-        lines += [f"  A_{k} = {value}" for k, value in enumerate(amplitude)]
-        lines += [f"  phi_{k} = {value}" for k, value in enumerate(phase)]
-    return "\n".join(lines)
 
 
 def _pretty_definitions(definitions: Any) -> str:
@@ -321,7 +292,9 @@ def _pretty_expansion(expansion: Any, *, waveforms: bool = False) -> str:
         blocks.append(f"ω(ε) = {series} + O(ε{_superscript(terms)})")
     else:
         blocks.append(f"ω(ε) = Σₖ ωₖ·({_pretty(expansion.gauge)})ᵏ   (grazing: not analytic in ε)")
-    definitions, omega, amplitude, phase = _readable(expansion)
+    from ..results._readable import readable_coefficients
+
+    definitions, omega, amplitude, phase = readable_coefficients(expansion)
     if definitions:
         blocks.append(_pretty_definitions(definitions))
     blocks += [_pretty_equation(f"omega_{k}", value) for k, value in enumerate(omega)]

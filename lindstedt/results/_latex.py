@@ -14,6 +14,7 @@ from typing import Any, Mapping, Sequence
 import sympy
 
 from ..render.display import latex_text
+from ._readable import readable_coefficients
 from ..problems.oscillator import Oscillator
 from ..problems.parsing import parse_expression
 
@@ -128,15 +129,18 @@ def expansion_latex(expansion: Any, waveforms: bool) -> str:
     assumptions = _assumptions_latex(expansion)
     if assumptions:
         lines.append(r"& " + assumptions)
-    for exponent, value in zip(expansion.exponents, expansion.omega):  # ω_{k/2} multiplies ε^{k/2} in the gauge sqrt(ε)
+    definitions, omega, amplitude, phase = readable_coefficients(expansion)
+    if definitions:
+        lines.append(r"& \text{where } " + r",\ ".join(f"{latex(symbol)} = {latex(value)}" for symbol, value in definitions))
+    for exponent, value in zip(expansion.exponents, omega):  # ω_{k/2} multiplies ε^{k/2} in the gauge sqrt(ε)
         lines.append(rf"\omega_{{{exponent}}} &= {latex(value)}")
     remainder = rf" + O(\varepsilon^{{{latex(sympy.Rational(expansion._steps * expansion.order + 1, expansion._steps))}}})"
     names = [rf"\omega_{{{exponent}}}" for exponent in expansion.exponents]
-    lines.append(r"\omega(\varepsilon) &= " + _series_latex(expansion.omega, expansion.gauge, names) + remainder)
+    lines.append(r"\omega(\varepsilon) &= " + _series_latex(omega, expansion.gauge, names) + remainder)
     if problem.has_initial_velocity:
         lines.append(r"u(t) &= v(\omega t + \varphi(\varepsilon); \varepsilon),\quad v(0; \varepsilon) = A(\varepsilon)")
-        lines.append(r"A(\varepsilon) &= " + _series_latex(expansion.amplitude, expansion.gauge) + remainder)
-        lines.append(r"\varphi(\varepsilon) &= " + _series_latex(expansion.phase, expansion.gauge) + remainder)
+        lines.append(r"A(\varepsilon) &= " + _series_latex(amplitude, expansion.gauge) + remainder)
+        lines.append(r"\varphi(\varepsilon) &= " + _series_latex(phase, expansion.gauge) + remainder)
     if waveforms:
         for waveform in expansion.waveforms:
             lines.append(rf"v_{{{waveform.order}}}(s) &= {waveform.to_latex()}")

@@ -35,6 +35,7 @@ import sympy
 from .._precision import locked
 from ..render.display import labelled_repr, shorten
 from ..render.json import finite_float
+from ._readable import readable_coefficients
 from .waveforms import PiecewiseWaveform
 
 __all__ = ["SCHEMA", "expansion_dict", "expansion_repr", "expansion_summary"]
@@ -113,14 +114,17 @@ def expansion_dict(expansion: Any, waveforms: bool) -> dict[str, Any]:
 
 
 def expansion_summary(expansion: Any) -> str:
-    """Plain-text summary: the problem and ω_0..ω_N."""
+    """Plain-text summary: the problem and ω_0..ω_N (in the contact angles, defined once, when they have any)."""
+    definitions, omega, amplitude, phase = readable_coefficients(expansion)
     lines = [expansion.problem.describe()]
+    if definitions:
+        lines.append("  where " + ", ".join(f"{symbol} = {value}" for symbol, value in definitions))
     if expansion._steps != 1:
         lines.append(f"  omega(eps) = sum_k omega_k {expansion.gauge}**k (grazing: not analytic in eps)")
-    for k, value in enumerate(expansion.omega):
+    for k, value in enumerate(omega):
         lines.append(f"  omega_{k} = {value}")
     if expansion.problem.has_initial_velocity:
         lines.append("  u(t) = v(omega*t + phi(eps); eps), released at the turning point A(eps) = v(0; eps) > 0")
-        lines += [f"  A_{k} = {value}" for k, value in enumerate(expansion.amplitude)]
-        lines += [f"  phi_{k} = {value}" for k, value in enumerate(expansion.phase)]
+        lines += [f"  A_{k} = {value}" for k, value in enumerate(amplitude)]
+        lines += [f"  phi_{k} = {value}" for k, value in enumerate(phase)]
     return "\n".join(lines)
