@@ -15,8 +15,11 @@ The public API is re-exported here and in the documented public subpackages:
 * :mod:`lindstedt.cli` — the ``lindstedt`` command (``python -m lindstedt``).
 
 Behind the facade the package is laid out as the pipeline: ``problems/`` →
-``methods/`` → ``engine/`` → ``results/`` → ``export/`` (their public names are
-re-exported here); modules whose names start with an underscore are private.
+``methods/`` → ``engine/`` → ``results/`` (on ``render/``, their display and JSON
+primitives, and ``compiled/``, their float evaluators) → ``export/`` (their public
+names are re-exported here); the imports go one way, without a circle, and no module
+is over 800 lines (``tests/test_import_graph.py``); modules whose names start with an
+underscore are private.
 
 Examples
 --------

@@ -121,7 +121,7 @@ class FlowResult(JsonExport):
     epsilon: float | None = field(default=None, repr=False, compare=False)
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dictionary (see :class:`~lindstedt.export.json.JsonExport`); a forced problem as in ``system`` above.
+        """JSON-ready dictionary (see :class:`~lindstedt.render.json.JsonExport`); a forced problem as in ``system`` above.
 
         Examples
         --------

@@ -4,8 +4,8 @@ and the bifurcations located on it (:class:`Bifurcation`).
 The responses are those of ``u'' + 2 ζ ω0 u' + ω0² u + ε f(u) = ε s F cos(Ω t)`` and
 ``M X'' + C X' + K X + ε W (A X − b)_+ = ε s P cos(Ω t)``, computed by
 :mod:`lindstedt.numerics.forced_response`.  Each is a frozen dataclass exporting itself through
-:mod:`lindstedt.export.json` (schemas ``lindstedt.forced-orbit/1``, ``lindstedt.bifurcation/1``,
-``lindstedt.frequency-response/1``) and showing itself through :mod:`lindstedt.export.display`
+:mod:`lindstedt.render.json` (schemas ``lindstedt.forced-orbit/1``, ``lindstedt.bifurcation/1``,
+``lindstedt.frequency-response/1``) and showing itself through :mod:`lindstedt.render.display`
 (``__repr__``, ``_repr_html_``); :meth:`FrequencyResponse.to_dataframe` needs pandas
 (``pip install lindstedt[pandas]``).
 

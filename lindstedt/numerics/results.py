@@ -7,7 +7,7 @@ of the computation; a failure carries its reason and is never raised.  A
 continuation returns an :class:`NNMBranch` (points in branch order, folds,
 stability and contact changes) and reports its progress as
 :class:`ContinuationProgress`.  All three export themselves to JSON through
-:mod:`lindstedt.export.json` (schemas ``lindstedt.nnm-numeric/1``,
+:mod:`lindstedt.render.json` (schemas ``lindstedt.nnm-numeric/1``,
 ``lindstedt.nnm-branch/1``, ``lindstedt.continuation-progress/1``).
 
 Examples
