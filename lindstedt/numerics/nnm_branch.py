@@ -320,8 +320,11 @@ class _NNMArclength(_NNMStepper, Arclength):
         return (result, "") if result.success else (None, result.message)
 
     def multipliers(self, point: NNMResult | None, evaluation: Evaluation) -> np.ndarray:
-        """The non-trivial multipliers from the evaluation's sensitivity (:meth:`NNMShooting.monodromy_of`): no
-        verification flow, so the special points are located on the corrector's evaluations alone."""
+        """The non-trivial multipliers of a verified point, else from the evaluation's sensitivity
+        (:meth:`NNMShooting.monodromy_of`): no verification flow, so the special points are located on the
+        corrector's evaluations alone."""
+        if point is not None:
+            return point.nontrivial_multipliers
         out = evaluation.data
         w = out["unknowns"]
         eps, _ = self.path.at(float(w[-1]))
