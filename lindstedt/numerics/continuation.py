@@ -72,7 +72,8 @@ from .arclength import drive
 from .nnm_branch import METHODS, _check_parameter, _continuation_setup, _NNMArclength, _Path
 from .results import ContinuationProgress, NNMBranch, NNMResult
 from .sensitivity import _check_epsilon
-from .shooting import NNMShooting, _Amplitude, _ExpansionPredictor, _impossible_amplitude, _guess_unknowns
+from .nnm_guesses import _ExpansionPredictor, _guess_unknowns, _impossible_amplitude
+from .shooting import NNMShooting, _Amplitude
 
 __all__ = ["continue_nnm", "nnm_point", "nnm_sweep"]
 

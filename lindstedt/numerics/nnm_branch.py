@@ -37,7 +37,8 @@ from .forced_results import Bifurcation
 from .newton import Evaluation, NewtonOutcome, newton
 from .results import NNMBranch, NNMResult, _branch_events
 from .sensitivity import _check_epsilon, _map_over
-from .shooting import _STEP_TOL, _TWO_PI, NNMShooting, _Amplitude, _impossible_amplitude, nnm_energy
+from .nnm_guesses import _impossible_amplitude
+from .shooting import _STEP_TOL, _TWO_PI, NNMShooting, _Amplitude, nnm_energy
 
 _PARAMETERS = ("epsilon", "energy", "modal_amplitude")
 
