@@ -33,7 +33,7 @@ import mpmath
 from .._errors import ConvergenceError, ProblemError, UnsupportedNonlinearityError
 from .._precision import workdps
 from .breakpoints import _SUPPORTED, _PiecewisePotential
-from .trapezoid import _escape_distances, _orbit_scale, _separatrix_error
+from .trapezoid import _escape_distances, _orbit_scale, _separatrix_error, _turning_distance
 
 
 class _PiecewiseOrbit:
@@ -143,29 +143,10 @@ def _piecewise_turning_point(
             "or the amplitude"
         )
     # Safeguarded Newton inside one piece (V is analytic there).
-    low, high = bracket
-    guess = high
-    tolerance = mpmath.eps * 8 * max(scale, abs(start))
-    for _ in range(mpmath.mp.prec + 100):
-        position = start + direction * guess
-        value = energy - orbit.value(position, piece)
-        if value == 0:
-            break
-        if value > 0:
-            low = guess
-        else:
-            high = guess
-        derivative = -direction * orbit.slope(position, piece)
-        candidate = guess - value / derivative if derivative != 0 else low - 1
-        if not low <= candidate <= high:
-            candidate = (low + high) / 2
-        change = abs(candidate - guess)
-        guess = candidate
-        if change <= tolerance or high - low <= tolerance:
-            break
-    else:
-        raise ConvergenceError("root finding for a turning point did not converge")
-    return start + direction * guess, piece
+    distance = _turning_distance(lambda d: energy - orbit.value(start + direction * d, piece),
+                                 lambda d: -direction * orbit.slope(start + direction * d, piece), bracket,
+                                 mpmath.eps * 8 * max(scale, abs(start)), mpmath.mp.prec + 100)
+    return start + direction * distance, piece
 
 
 def _tanh_sinh(integrand: Callable[[Any], Any], lower: mpmath.mpf, upper: mpmath.mpf, target_digits: int) -> tuple[mpmath.mpf, mpmath.mpf]:

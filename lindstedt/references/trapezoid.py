@@ -122,20 +122,27 @@ def _smooth_turning_point(
         previous = current
     else:
         raise ConvergenceError(escape_message)
-    # Safeguarded Newton on the bracket [previous, current] of distances.
-    low, high = previous, current
+    distance = _turning_distance(lambda d: excess(origin + direction * d),
+                                 lambda d: -direction * potential.slope(origin + direction * d, epsilon, omega0),
+                                 (previous, current), mpmath.eps * 8 * max(scale, abs(origin)), 400)
+    return origin + direction * distance
+
+
+def _turning_distance(excess: Any, slope: Any, bracket: tuple[mpmath.mpf, mpmath.mpf], tolerance: mpmath.mpf,
+                      max_iterations: int) -> mpmath.mpf:
+    """The distance d in ``bracket`` where ``excess(d) = E − V`` vanishes (positive before it), by safeguarded
+    Newton with the derivative ``slope(d)``: a step leaving the bracket is a bisection (V analytic inside)."""
+    low, high = bracket
     guess = high
-    tolerance = mpmath.eps * 8 * max(scale, abs(origin))
-    for _ in range(400):
-        position = origin + direction * guess
-        value = excess(position)
+    for _ in range(max_iterations):
+        value = excess(guess)
         if value == 0:
             break
         if value > 0:
             low = guess
         else:
             high = guess
-        derivative = -direction * potential.slope(position, epsilon, omega0)
+        derivative = slope(guess)
         candidate = guess - value / derivative if derivative != 0 else low - 1
         if not low <= candidate <= high:
             candidate = (low + high) / 2
@@ -145,7 +152,7 @@ def _smooth_turning_point(
             break
     else:
         raise ConvergenceError("root finding for a turning point did not converge")
-    return origin + direction * guess
+    return guess
 
 
 def _find_other_turning_point(
