@@ -212,6 +212,13 @@ def step_factor(outcome: NewtonOutcome, target: float, smooth: bool = True) -> f
 
     The error factor ``sqrt(target / first correction)`` (kept in [0.5, 2]) and the iteration factor (×1.5
     after ≤ 2 iterations) each may grow the step; ≥ 4 iterations stop the growth, ≥ 5 shrink it (×0.6 at least).
+
+    Examples
+    --------
+    >>> step_factor(NewtonOutcome(True, "", np.zeros(1), 2, steps=(2e-3,)), 2e-3)   # on target, quick: grow
+    1.5
+    >>> step_factor(NewtonOutcome(True, "", np.zeros(1), 6, steps=(8e-3,)), 2e-3)   # slow: shrink
+    0.5
     """
     iterations, steps = outcome.iterations, outcome.steps
     error = min(max(math.sqrt(target / steps[0]), 0.5), 2.0) if steps and steps[0] > 0 else 2.0
@@ -230,6 +237,15 @@ def bifurcation_tests(multipliers: np.ndarray | None, unit_tangent: np.ndarray, 
     ``multipliers`` are the non-trivial Floquet multipliers (every one of a forced orbit); ``scaled_jacobian``
     is ``[∂G/∂z, ∂G/∂λ] · D``.  NaN where a test does not apply (the Neimark–Sacker test on conservative
     branches and with fewer than four multipliers).
+
+    Examples
+    --------
+    A real multiplier past −1 makes the period-doubling test negative:
+
+    >>> tests = bifurcation_tests(np.array([-1.2, 0.5]), np.array([0.0, 1.0]), np.array([[1.0, 0.0]]),
+    ...                           conservative=False)
+    >>> tests["fold"], round(tests["period-doubling"], 12), tests["branch-point"]
+    (1.0, -0.3, 1.0)
     """
     bordered = np.vstack([scaled_jacobian, unit_tangent])
     tests = {"fold": float(unit_tangent[-1]),
@@ -253,6 +269,14 @@ def locate_kind(kind: str, f0: float, f1: float, h: float, probe: Callable[[floa
     (or after ``max_iterations`` probes), or None — also when the test does not go to zero but jumps (still
     above ``_JUMP_RATIO`` of its values at the ends after ``_JUMP_PROBES`` probes, or above ``_ZERO_RATIO`` of
     them at the end: the test is discontinuous where the residual is not smooth, e.g. at a grazing).
+
+    Examples
+    --------
+    >>> found = locate_kind("fold", -1.0, 3.0, 2.0, lambda s: (s * s - 0.5, s), tol=1e-12)
+    >>> abs(found[0] - 0.5**0.5) < 1e-12
+    True
+    >>> locate_kind("fold", -1.0, 1.0, 2.0, lambda s: (-1.0 if s < 1 else 1.0, s), tol=1e-12) is None  # a jump
+    True
     """
     a, fa, b, fb = 0.0, f0, h, f1
     scale = max(abs(f0), abs(f1))

@@ -654,7 +654,14 @@ class ExactFlow:
 
     def sample(self, state0: Any, frequency: float, *, periods: int = 1, forcing_scale: float = 1.0,
                samples: int = 256) -> tuple[np.ndarray, np.ndarray]:
-        """``(t, z(t))`` at ``samples`` equally spaced times of ``[0, 2πk/Ω)`` (dense closed-form output)."""
+        """``(t, z(t))`` at ``samples`` equally spaced times of ``[0, 2πk/Ω)`` (dense closed-form output).
+
+        Examples
+        --------
+        >>> t, z = ExactFlow(UnilateralSystem.one_dof(1), epsilon=0.0).sample([1.0, 0.0], 1.0, samples=4)
+        >>> (np.round(z[:, 0], 12) + 0.0).tolist()
+        [1.0, 0.0, -1.0, 0.0]
+        """
         n = self.system.n_dof
         z0 = _as_state_vector(state0, 2 * n, "state0")
         horizon = 2.0 * math.pi * int(periods) / _as_time(frequency, "frequency")

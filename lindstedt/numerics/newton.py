@@ -128,6 +128,18 @@ def newton(
     Returns
     -------
     NewtonOutcome
+
+    Examples
+    --------
+    The intersection of the unit circle with the line ``z0 = z1``, from a guess far out (the first steps are
+    cut to the trust bound 1):
+
+    >>> def circle(z):
+    ...     return Evaluation(True, "", np.array([z @ z - 1.0, z[0] - z[1]]),
+    ...                       np.array([[2 * z[0], 2 * z[1]], [1.0, -1.0]]), step_bound=1.0)
+    >>> outcome = newton(circle, np.array([10.0, 3.0]), np.ones(2), tol=1e-14, max_iterations=30)
+    >>> outcome.success, np.round(outcome.unknowns, 12).tolist()
+    (True, [0.707106781187, 0.707106781187])
     """
     z = np.array(unknowns, dtype=float)
     current = first if first is not None else evaluate(z)
