@@ -61,6 +61,8 @@ _LAZY = {
     "methods.multiple_scales": ("MultipleScales", "frequency_response_curve"),
     "results.frequency_response": ("FrequencyResponseCurve",),
     "problems.system": ("Modes", "UnilateralSystem"),
+    "problems.structures": ("read_matrices", "sparse_modes"),
+    "problems.beam": ("EulerBernoulliBeam",),
     "validate": (
         "Spectrum",
         "contact_measure",
@@ -104,6 +106,9 @@ __all__ = [
     "Oscillator",
     "UnilateralSystem",
     "Modes",
+    "read_matrices",
+    "sparse_modes",
+    "EulerBernoulliBeam",
     "StrainedCoordinatesNNM",
     "NNMProblem",
     "NNMExpansion",

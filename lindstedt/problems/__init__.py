@@ -6,6 +6,10 @@
 * :mod:`~lindstedt.problems.system` — ``M X'' + K X + ε W (A X − b)_+ = 0`` and its linear modes;
 * :mod:`~lindstedt.problems.matrices` — exact matrices read from user input, and their float copies;
 * :mod:`~lindstedt.problems.modes` — the linear modes ``K Φ = M Φ diag(λ²)``, float64 then multiprecision;
+* :mod:`~lindstedt.problems.structures` — ``M``, ``K`` (``C``) read from ``.npz``/``.mat``/``.mtx`` files, and the
+  lowest modes of large sparse models (shift-invert Lanczos);
+* :mod:`~lindstedt.problems.beam` — the Euler–Bernoulli beam in cubic Hermite elements with breathing cracks
+  (unilateral rotational springs), as a ``UnilateralSystem`` or sparse matrices;
 * :mod:`~lindstedt.problems.nnm` — the NNM of one mode of such a system.
 
 The public names are re-exported by :mod:`lindstedt`.
