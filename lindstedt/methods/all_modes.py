@@ -134,6 +134,7 @@ def all_modes_first_order(
     >>> [round(value, 12) for value, _ in result.corrections]
     [0.125, 0.072168783649]
     """
+    system.require_unilateral("the first-order frequency shifts of every mode (all_modes_first_order)")
     modes = system.modes()
     lambdas = np.asarray(modes.frequencies, dtype=float)
     size = system.n_dof

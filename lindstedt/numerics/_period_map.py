@@ -81,8 +81,9 @@ class PeriodMap(Protocol):
 
 def linear_frequency_bounds(problem: Any, epsilon: float, slopes: Sequence[float] = ()) -> tuple[float, float] | None:
     """(lowest, highest) frequency of the linear pieces of a forced problem, ``ω² = eig(M⁻¹(K + ε·slope))``: for an
-    oscillator ``ω0² + ε·slope`` over 0 and its law's ``slopes``, for a system K and K + ε W A; None when they cannot
-    be formed (symbols left, a singular M).  A square beyond the float range is an infinite frequency.
+    oscillator ``ω0² + ε·slope`` over 0 and its law's ``slopes``, for a system K and K + ε W diag(s) A with the
+    steepest slope s of each element's law (``slopes``, one per element; 1 for unilateral springs); None when
+    they cannot be formed (symbols left, a singular M).  A square beyond the float range is an infinite frequency.
 
     Every flow of the package reports its own (``linear_frequencies()``): the cost checks and step sizes use them.
 
@@ -100,7 +101,8 @@ def linear_frequency_bounds(problem: Any, epsilon: float, slopes: Sequence[float
             s = problem.system
             A = np.array(s.A, dtype=float).reshape(-1, s.n_dof)
             W = np.array(s.W, dtype=float).reshape(s.n_dof, -1)
-            stiffnesses = [s.K] + ([s.K + epsilon * W @ A] if A.size else [])
+            steepest = np.asarray(slopes, dtype=float) if len(slopes) == A.shape[0] else np.ones(A.shape[0])
+            stiffnesses = [s.K] + ([s.K + epsilon * (W * steepest) @ A] if A.size else [])
             squares = [float(x) for K in stiffnesses for x in np.linalg.eigvals(np.linalg.solve(s.M, K)).real]
         else:
             return None

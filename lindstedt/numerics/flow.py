@@ -286,6 +286,7 @@ class ExactFlow:
     def __init__(self, system: UnilateralSystem, epsilon: float, *, max_arcs: int = 1_000_000) -> None:
         if not isinstance(system, UnilateralSystem):
             raise ProblemError(f"ExactFlow needs a UnilateralSystem, got {type(system).__name__}")
+        system.require_unilateral("the exact flow (ExactFlow)")
         try:
             eps_value = float(epsilon)
         except (TypeError, ValueError):

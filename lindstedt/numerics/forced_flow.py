@@ -158,6 +158,7 @@ class ForcedFlow:
         self.max_arcs = int(max_arcs)
         if isinstance(problem, ForcedSystem):
             system = problem.system
+            system.require_unilateral("the exact forced flow (ForcedFlow)")
             self._M, self._K, self._C = system.M, system.K, np.asarray(problem.C, dtype=float)
             self._P = np.asarray(problem.P, dtype=float)
             self._a, self._b, self._W = system.A, system.b, system.W

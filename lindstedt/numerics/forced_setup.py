@@ -67,9 +67,10 @@ def _description(flow: Any) -> Any:
 def forced_flow(problem: ForcedOscillator | ForcedSystem, epsilon: float) -> PeriodMap:
     """The flow that computes ``problem``'s responses: exact where it can be, DOP853 elsewhere.
 
-    A :class:`~lindstedt.ForcedSystem`, or a :class:`~lindstedt.ForcedOscillator` whose f is piecewise linear
-    (unilateral springs, gaps, jumps), gets the exact event-driven :class:`~lindstedt.numerics.ForcedFlow`;
-    any other f (u³, Hertz contact, …) the DOP853 flow with variational equations
+    A :class:`~lindstedt.ForcedSystem` of unilateral springs, or a :class:`~lindstedt.ForcedOscillator` whose f
+    is piecewise linear (unilateral springs, gaps, jumps), gets the exact event-driven
+    :class:`~lindstedt.numerics.ForcedFlow`; any other law (u³, Hertz contact, …, on one degree of freedom or on
+    the elements of a system) the DOP853 flow with variational equations
     :class:`~lindstedt.numerics.SmoothForcedFlow`.
 
     Examples
@@ -85,7 +86,7 @@ def forced_flow(problem: ForcedOscillator | ForcedSystem, epsilon: float) -> Per
     from .forced_smooth import SmoothForcedFlow
 
     if isinstance(problem, ForcedSystem):
-        return ForcedFlow(problem, epsilon)
+        return ForcedFlow(problem, epsilon) if problem.system.unilateral else SmoothForcedFlow(problem, epsilon)
     if not isinstance(problem, ForcedOscillator):
         raise ProblemError(f"expected a ForcedOscillator or a ForcedSystem, got {type(problem).__name__}")
     try:

@@ -22,8 +22,10 @@ sensitivities cross the switch through the saltation matrix ``S = I + Δ nᵀ/(n
 f and f' come from the parsed sympy expression (``problem.nonlinearity``) by ``sympy.lambdify``.
 
 Both problems are one form, ``ε Σ_i w_i f_i(a_iᵀ X − b_i)`` (:class:`_Elements`): one oscillator is N = 1 with the
-element ``(f, 1, 0, 1)``, a unilateral system has the elements ``((·)_+, A_i, b_i, W_i)``; the regions, events
-and saltation matrices are the elements'.  One oscillator runs a scalar kernel of the same field.
+element ``(f, 1, 0, 1)``, a system has the elements ``(laws_i, A_i, b_i, W_i)`` (unilateral springs ``Max(0, u)``
+by default, any law of the 1-dof library per element); the regions, events and saltation matrices are the
+elements'.  One oscillator runs a scalar kernel of the same field; regions where every piece is affine fold the
+forces into one matrix.
 
 Examples
 --------
@@ -46,6 +48,7 @@ from .._errors import ConvergenceError, ProblemError, UnsupportedNonlinearityErr
 from ..limits import checkpoint
 from .._precision import locked
 from ..problems.forced import ForcedOscillator, ForcedSystem, check_forcing_frequency
+from ..problems.system import LAW_VARIABLE
 from ._period_map import PeriodMapValue, linear_frequency_bounds, real_argument
 
 __all__ = ["SmoothForcedFlow"]
@@ -148,11 +151,6 @@ class _ScalarLaw:
         if index > 0 and u == self.breakpoints[index - 1] and v < 0:
             index -= 1
         return index
-
-
-#: the law of a unilateral spring, (u)_+
-_U = sympy.Symbol("u")
-_PLUS = sympy.Max(0, _U)
 
 
 class _Elements:
@@ -307,11 +305,12 @@ class SmoothForcedFlow:
             M_inv = np.linalg.inv(system.M)
             self._Km, self._Cm, self._Pm = M_inv @ system.K, M_inv @ problem.C, M_inv @ problem.P
             A = np.array(system.A, dtype=float).reshape(-1, self.n_dof)
-            plus = _ScalarLaw(_PLUS, _U)
-            self._elements = _Elements([plus] * A.shape[0], A, np.array(system.b, dtype=float).reshape(-1),
+            laws: dict[Any, _ScalarLaw] = {}  # one lambdified law per distinct law
+            elements = [laws.setdefault(law, _ScalarLaw(law, LAW_VARIABLE)) for law in system.laws]
+            self._elements = _Elements(elements, A, np.array(system.b, dtype=float).reshape(-1),
                                        M_inv @ np.array(system.W, dtype=float).reshape(self.n_dof, -1))
             self.breakpoints = ()
-            slopes = []
+            slopes = [max(abs(float(slope(point))) for _, slope, point in law.pieces) for law in elements]
         else:
             raise ProblemError(
                 f"problem must be a ForcedOscillator or a ForcedSystem (lindstedt.problems.forced), got {type(problem).__name__}")
@@ -386,22 +385,34 @@ class SmoothForcedFlow:
 
             return scalar
         Cm, Pm, width = self._Cm, self._Pm, 2 * n + 2
-        affine = self._elements.affine(region)
-        if affine is None:  # the N-dof laws of this flow are unilateral springs: every piece is affine
-            raise UnsupportedNonlinearityError("this flow takes N-dof systems with piecewise-linear (unilateral) "
-                                               "springs; a law with a non-affine piece needs one degree of freedom")
-        Km, offset = self._Km + eps * affine[0], eps * affine[1]
+        elements = self._elements
+        affine = elements.affine(region)
+        if affine is not None:  # every piece affine (unilateral springs): one matrix for the whole region
+            Km, offset = self._Km + eps * affine[0], eps * affine[1]
+
+            def restoring(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                return Km @ x - offset, Km
+        else:  # the laws' analytic pieces: M⁻¹(K X + ε Σ_i w_i f_i(u_i)) and its Jacobian K + ε Σ_i w_i f_i'(u_i) a_iᵀ
+            pieces = [law.pieces[r] for law, r in zip(elements.laws, region)]
+            A, b, MW, K = elements.A, elements.b, elements.MW, self._Km
+
+            def restoring(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                u = A @ x - b
+                forces = np.array([value(ui) for (value, _, _), ui in zip(pieces, u)])
+                slopes = np.array([slope(ui) for (_, slope, _), ui in zip(pieces, u)])
+                return K @ x + eps * (MW @ forces), K + eps * (MW * slopes) @ A
 
         def system(t: float, y: np.ndarray) -> np.ndarray:
             x, v = y[:n], y[n:2 * n]
             phase = frequency * t
-            a = eps * scale * math.cos(phase) * Pm - Km @ x + offset - Cm @ v
+            force, tangent = restoring(x)
+            a = eps * scale * math.cos(phase) * Pm - force - Cm @ v
             if not sensitivity:
                 return np.concatenate((v, a))
             Y = y[2 * n:].reshape(2 * n, width)
             dY = np.empty_like(Y)
             dY[:n] = Y[n:]
-            dY[n:] = -Km @ Y[:n] - Cm @ Y[n:]
+            dY[n:] = -tangent @ Y[:n] - Cm @ Y[n:]
             dY[n:, 2 * n] -= eps * scale * t * math.sin(phase) * Pm
             dY[n:, 2 * n + 1] += eps * math.cos(phase) * Pm
             return np.concatenate((v, a, dY.reshape(-1)))

@@ -255,6 +255,7 @@ class NNMShooting:
     ) -> None:
         if not isinstance(system, UnilateralSystem):
             raise ProblemError(f"system must be a UnilateralSystem, got {type(system).__name__}")
+        system.require_unilateral("NNM shooting (nnm_point, continue_nnm, nnm_sweep)")
         if formulation not in _FORMULATIONS:
             raise ProblemError(f"formulation must be one of {_FORMULATIONS}, got {formulation!r}")
         if release_sign not in (1, -1):

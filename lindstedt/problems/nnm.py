@@ -45,6 +45,7 @@ class NNMProblem:
     def __post_init__(self) -> None:
         if not isinstance(self.system, UnilateralSystem):
             raise ProblemError("system must be a UnilateralSystem (see UnilateralSystem.from_json_dict)")
+        self.system.require_unilateral("the strained-coordinates NNM expansion (lindstedt.nnm)")
         if isinstance(self.mode, bool) or not isinstance(self.mode, int) or not 1 <= self.mode <= self.system.n_dof:
             raise ProblemError(f"mode must be an integer between 1 and {self.system.n_dof}, got {self.mode!r}")
         amplitude = parse_real(self.a0, what="a0")

@@ -29,14 +29,37 @@ from typing import Any, Iterable, Mapping, NamedTuple, Sequence
 import numpy as np
 import sympy
 
-from .._errors import ProblemError
+from .._errors import ProblemError, UnsupportedNonlinearityError
 from .._precision import cached_property, locked, locked_methods
 from .matrices import _check_symmetric_positive_definite, _exact_matrix, _exact_scalar, _exactly_equal, _float_array
 from .modes import _float_modes, _high_precision_modes, _modal_coupling
+from .parsing import parse_expression
 
 __all__ = ["UnilateralSystem", "Modes", "OneDofUnilateral"]
 
-_JSON_KEYS = ("M", "K", "A", "b", "W")
+_JSON_KEYS = ("M", "K", "A", "b", "W", "laws")
+#: the variable of an element's law f(u) (the oscillator's u)
+LAW_VARIABLE = sympy.Symbol("u", real=True)
+#: the law of a unilateral spring, the default of every element
+UNILATERAL = sympy.Max(0, LAW_VARIABLE)
+
+
+def _element_laws(laws: Any, m: int) -> tuple[sympy.Expr, ...]:
+    """One law f_i(u) per row of A, read by the one parser (default: every element a unilateral spring)."""
+    if laws is None:
+        return (UNILATERAL,) * m
+    if isinstance(laws, (str, bytes)) or not isinstance(laws, Sequence):
+        raise ProblemError(f"laws must be a list of one law f(u) per row of A, e.g. ['Max(0, u)', 'u**3'], got {laws!r}")
+    if len(laws) != m:
+        raise ProblemError(f"laws must have one law per row of A ({m}), got {len(laws)}")
+    read = []
+    for i, law in enumerate(laws):
+        expression = parse_expression(law, symbols={"u": LAW_VARIABLE}, what=f"laws[{i}]")
+        if not expression.has(LAW_VARIABLE):
+            raise ProblemError(f"laws[{i}] = {law!r} does not depend on u: a constant force is a load, not an element; "
+                               "write the law as a function of u = A_i X − b_i")
+        read.append(expression)
+    return tuple(read)
 
 
 class Modes(NamedTuple):
@@ -78,6 +101,12 @@ class UnilateralSystem:
     W : array_like, shape (N, m), optional
         Distribution of the spring forces on the masses; default ``Aᵀ``
         (the conservative case, with energy ``E`` of :meth:`energy`).
+    laws : sequence of str, optional
+        One law ``f_i(u)`` per row of A, the element's force ``ε W_i f_i(A_i X − b_i)`` (default: every
+        element the unilateral spring ``Max(0, u)``, the problem above).  Any law of the 1-dof library
+        (``"u**3"``, ``"Max(0, u)**(3/2)"``, …), read by the one parser.  The exact flow, NNM shooting
+        and the strained-coordinates NNMs take unilateral springs only (a typed error says so); forced
+        responses integrate any law (:class:`~lindstedt.numerics.SmoothForcedFlow`).
 
     Entries may be ints, floats, ``fractions.Fraction``, exact strings such as
     ``"1/3"`` or ``"sqrt(2)"``, or sympy numbers; decimal floats and strings are
@@ -89,6 +118,8 @@ class UnilateralSystem:
         Read-only float copies (correctly rounded from the exact values).
     M_exact, K_exact, A_exact, b_exact, W_exact : sympy.ImmutableMatrix
         Exact copies (``b_exact`` is a column).
+    laws : tuple of sympy expressions
+        The law of each element, in the variable ``u``.
 
     Raises
     ------
@@ -118,8 +149,9 @@ class UnilateralSystem:
     A_exact: sympy.ImmutableMatrix
     b_exact: sympy.ImmutableMatrix
     W_exact: sympy.ImmutableMatrix
+    laws: tuple[sympy.Expr, ...]
 
-    def __init__(self, M: Any, K: Any, A: Any = (), b: Any = (), W: Any | None = None) -> None:
+    def __init__(self, M: Any, K: Any, A: Any = (), b: Any = (), W: Any | None = None, laws: Any = None) -> None:
         M_exact = _exact_matrix(M, "M", ndim=2)
         K_exact = _exact_matrix(K, "K", ndim=2)
         n = M_exact.rows
@@ -171,6 +203,7 @@ class UnilateralSystem:
             ("A_exact", A_exact),
             ("b_exact", b_exact),
             ("W_exact", W_exact),
+            ("laws", _element_laws(laws, m)),
         ):
             object.__setattr__(self, attribute, value)
 
@@ -190,8 +223,31 @@ class UnilateralSystem:
         """True when ``W = Aᵀ`` exactly (conservative, symmetric effective stiffness)."""
         return all(_exactly_equal(self.W_exact[j, i], self.A_exact[i, j]) for i in range(self.n_springs) for j in range(self.n_dof))
 
+    @property
+    def unilateral(self) -> bool:
+        """True when every element is a unilateral spring ``Max(0, u)`` (the exact flow's problem)."""
+        return all(law == UNILATERAL for law in self.laws)
+
+    def require_unilateral(self, what: str) -> None:
+        """Raise :class:`~lindstedt.UnsupportedNonlinearityError` naming ``what`` unless every element is a
+        unilateral spring.
+
+        Examples
+        --------
+        >>> cubic = UnilateralSystem(M=[[1]], K=[[1]], A=[[1]], b=[0], laws=["u**3"])
+        >>> cubic.require_unilateral("the exact flow")
+        Traceback (most recent call last):
+            ...
+        lindstedt._errors.UnsupportedNonlinearityError: the exact flow takes unilateral springs Max(0, u) only; this system has the laws [u**3]: its forced responses run on the DOP853 flow (lindstedt.numerics.SmoothForcedFlow, chosen by forced_flow)
+        """
+        if not self.unilateral:
+            raise UnsupportedNonlinearityError(
+                f"{what} takes unilateral springs Max(0, u) only; this system has the laws "
+                f"[{', '.join(map(str, self.laws))}]: its forced responses run on the DOP853 flow "
+                "(lindstedt.numerics.SmoothForcedFlow, chosen by forced_flow)")
+
     def _key(self) -> tuple:
-        return (self.M_exact, self.K_exact, self.A_exact, self.b_exact, self.W_exact)
+        return (self.M_exact, self.K_exact, self.A_exact, self.b_exact, self.W_exact, self.laws)
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, UnilateralSystem):
@@ -203,7 +259,8 @@ class UnilateralSystem:
 
     def __repr__(self) -> str:
         coupling = "W=Aᵀ" if self.symmetric_coupling else "W≠Aᵀ"
-        return f"UnilateralSystem(N={self.n_dof}, m={self.n_springs}, {coupling})"
+        laws = "" if self.unilateral else f", laws=[{', '.join(map(str, self.laws))}]"
+        return f"UnilateralSystem(N={self.n_dof}, m={self.n_springs}, {coupling}{laws})"
 
     # ------------------------------------------------------------ constructors
     @classmethod
@@ -300,7 +357,7 @@ class UnilateralSystem:
 
     @classmethod
     def from_json_dict(cls, data: Mapping[str, Any]) -> "UnilateralSystem":
-        """Build from a mapping with keys ``M``, ``K``, ``A``, ``b`` and optional ``W``.
+        """Build from a mapping with keys ``M``, ``K``, ``A``, ``b`` and optional ``W`` and ``laws``.
 
         Entries may be numbers or exact strings (as written by :meth:`to_json_dict`).
 
@@ -314,16 +371,18 @@ class UnilateralSystem:
             raise ProblemError(f"from_json_dict expects a mapping with keys M, K, A, b (and optionally W), got {type(data).__name__}")
         unknown = sorted(set(data) - set(_JSON_KEYS))
         if unknown:
-            raise ProblemError(f"unknown keys {unknown} in the system definition; the keys are M, K, A, b and optional W")
+            raise ProblemError(f"unknown keys {unknown} in the system definition; the keys are M, K, A, b and optional W "
+                               "and laws")
         missing = [key for key in ("M", "K", "A", "b") if key not in data]
         if missing:
             raise ProblemError(f"the system definition lacks the keys {missing}; give M, K, A, b (A = [] and b = [] for none)")
-        return cls(M=data["M"], K=data["K"], A=data["A"], b=data["b"], W=data.get("W"))
+        return cls(M=data["M"], K=data["K"], A=data["A"], b=data["b"], W=data.get("W"), laws=data.get("laws"))
 
     def to_json_dict(self) -> dict[str, Any]:
         """Exact JSON-ready dictionary (entries as strings such as ``"1/3"``).
 
-        ``W`` is written only when it differs from ``Aᵀ``.
+        ``W`` is written only when it differs from ``Aᵀ``, ``laws`` only when an element is not a unilateral
+        spring.
 
         Examples
         --------
@@ -341,6 +400,8 @@ class UnilateralSystem:
         }
         if not self.symmetric_coupling:
             data["W"] = matrix(self.W_exact)
+        if not self.unilateral:
+            data["laws"] = [str(law) for law in self.laws]
         return data
 
     # ------------------------------------------------------------ quantities
@@ -449,6 +510,7 @@ class UnilateralSystem:
         >>> UnilateralSystem.one_dof(1).acceleration([2.0], 0.5).tolist()
         [-3.0]
         """
+        self.require_unilateral("acceleration()")
         positions = np.asarray(x, dtype=float)
         force = positions @ self.K.T + epsilon * np.maximum(self.gaps(positions), 0.0) @ self.W.T
         return -np.linalg.solve(self.M, force.reshape(-1, self.n_dof).T).T.reshape(force.shape)
@@ -463,6 +525,7 @@ class UnilateralSystem:
         >>> UnilateralSystem.one_dof(1).energy([2.0], [1.0], 0.5)
         3.5
         """
+        self.require_unilateral("energy()")
         if not self.symmetric_coupling:
             raise ProblemError("the energy E is conserved only for W = Aᵀ; this system has W ≠ Aᵀ")
         positions = np.asarray(x, dtype=float)

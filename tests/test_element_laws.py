@@ -1,0 +1,111 @@
+"""N-dof systems whose elements carry any law of the 1-dof library (issue 25, first slice: forced responses).
+
+``M X'' + C X' + K X + ε Σ_i W_i f_i(A_i X − b_i) = ε P cos(Ω t)``, here with a cubic element.  References, none
+of them the code under test:
+
+* an independent integration of the ODE by scipy's DOP853 over many periods from rest, to the steady state:
+  the damped transient decays as exp(−ζ_min ω_min t) (below 1e-12 here), the integrator's own error is estimated
+  by the difference of two tolerances;
+* the same oscillator written as one degree of freedom (:class:`lindstedt.ForcedOscillator`, the scalar kernel):
+  N = 1 is the one-dof problem.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import lindstedt
+from lindstedt import ForcedOscillator, ForcedSystem, UnilateralSystem, UnsupportedNonlinearityError
+from lindstedt.numerics import ExactFlow, SmoothForcedFlow, forced_flow, forced_periodic_orbit
+
+M = np.eye(2)
+K = np.array([[2.0, -1.0], [-1.0, 2.0]])
+C = 0.05 * K + 0.02 * M  # Rayleigh damping: ζ ≥ 0.01 on both modes
+EPSILON, OMEGA = 0.5, 1.3
+LOAD = np.array([1.0, 0.0])
+
+
+def _cubic_chain() -> ForcedSystem:
+    """A two-mass chain with a cubic spring between mass 1 and the ground, forced on mass 1."""
+    system = UnilateralSystem(M=M.tolist(), K=K.tolist(), A=[[1, 0]], b=[0], laws=["u**3"])
+    return ForcedSystem(system, LOAD.tolist(), C=C.tolist())
+
+
+def _steady_state(rtol: float, periods: int) -> np.ndarray:
+    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+        x, v = y[:2], y[2:]
+        force = K @ x + C @ v + EPSILON * np.array([x[0] ** 3, 0.0]) - EPSILON * LOAD * math.cos(OMEGA * t)
+        return np.r_[v, -force]
+
+    end = 2 * math.pi * periods / OMEGA
+    return solve_ivp(rhs, (0.0, end), np.zeros(4), method="DOP853", rtol=rtol, atol=rtol * 1e-2).y[:, -1]
+
+
+def test_a_cubic_element_forced_orbit_is_the_steady_state_of_the_ode():
+    orbit = forced_periodic_orbit(_cubic_chain(), OMEGA, epsilon=EPSILON)
+    assert orbit.success and orbit.stable, orbit.message
+    # ζ_min ω_min ≥ 0.01 · 1 → after 600 periods (t ≈ 2900) the transient is below exp(-29) ≈ 3e-13
+    fine, coarse = _steady_state(1e-12, 600), _steady_state(1e-10, 600)
+    error = float(np.max(np.abs(fine - coarse)))  # measured 1.7e-11; the orbit differs from `fine` by 2.9e-13
+    assert error < 1e-9
+    assert np.max(np.abs(orbit.state - fine)) <= 10 * error + 1e-12
+
+
+def test_one_degree_of_freedom_as_a_system_is_the_oscillator():
+    system = ForcedSystem(UnilateralSystem(M=[[1]], K=[[1]], A=[[1]], b=[0], laws=["u**3"]), [1], C=[["1/10"]])
+    oscillator = ForcedOscillator("u**3", omega0=1, zeta="1/20", forcing=1)
+    as_system = SmoothForcedFlow(system, 0.5).period_map([0.3, -0.1], 1.2)
+    as_oscillator = SmoothForcedFlow(oscillator, 0.5).period_map([0.3, -0.1], 1.2)
+    for a, b in ((as_system.state, as_oscillator.state), (as_system.d_state, as_oscillator.d_state),
+                 (as_system.d_frequency, as_oscillator.d_frequency), (as_system.d_forcing, as_oscillator.d_forcing)):
+        np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-11)  # two DOP853 runs at rtol 1e-12
+
+
+def test_the_flow_of_a_system_with_other_laws_is_the_dop853_one():
+    assert type(forced_flow(_cubic_chain(), EPSILON)).__name__ == "SmoothForcedFlow"
+    unilateral = ForcedSystem(UnilateralSystem(M=M.tolist(), K=K.tolist(), A=[[1, 0]], b=[0]), LOAD.tolist(),
+                              C=C.tolist())
+    assert type(forced_flow(unilateral, EPSILON)).__name__ == "ForcedFlow"
+
+
+def test_what_takes_unilateral_springs_only_refuses_other_laws_naming_the_way_out():
+    system = _cubic_chain().system
+    attempts = [
+        lambda: ExactFlow(system, 0.5),
+        lambda: lindstedt.nnm(system, 1, a0=1, order=1),
+        lambda: lindstedt.nnm_point(system, 0.5, 1, modal_amplitude=1.0),
+        lambda: lindstedt.continue_nnm(system, 1, modal_amplitude=1.0, start=0.0, stop=0.5),
+        lambda: lindstedt.all_modes_first_order(system, [1.0, 0.5]),
+        lambda: system.energy([0.1, 0.0], [0.0, 0.0], 0.5),
+        lambda: system.acceleration([0.1, 0.0], 0.5),
+        lambda: lindstedt.numerics.ForcedFlow(_cubic_chain(), 0.5),
+    ]
+    for attempt in attempts:
+        with pytest.raises(UnsupportedNonlinearityError, match=r"unilateral springs Max\(0, u\) only.*u\*\*3.*DOP853"):
+            attempt()
+
+
+def test_laws_are_read_by_the_one_parser_and_kept_in_json():
+    system = UnilateralSystem(M=[[1, 0], [0, 1]], K=[[2, -1], [-1, 2]], A=[[1, -1], [0, 1]], b=[0, "1/10"],
+                              laws=["u**3", "Max(0, u)**(3/2)"])
+    data = system.to_json_dict()
+    assert data["laws"] == ["u**3", "Max(0, u)**(3/2)"]
+    assert UnilateralSystem.from_json_dict(data) == system
+    assert not system.unilateral and UnilateralSystem.chain(2, [(0, 0)]).unilateral
+    assert "laws" not in UnilateralSystem.chain(2, [(0, 0)]).to_json_dict()  # old files and outputs unchanged
+
+
+@pytest.mark.parametrize("laws, error, words", [
+    (["u**3"], lindstedt.ProblemError, "one law per row of A"),
+    ("u**3", lindstedt.ProblemError, "a list of one law"),
+    (["u**3", "7"], lindstedt.ProblemError, "does not depend on u"),
+    (["u**3", "k*u"], lindstedt.ParameterError, "k"),
+    (["u**3", "__import__('os')"], lindstedt.ProblemError, "calling '__import__' is not allowed"),
+])
+def test_bad_laws_are_typed_errors(laws, error, words):
+    with pytest.raises(error, match=words):
+        UnilateralSystem(M=[[1, 0], [0, 1]], K=[[2, -1], [-1, 2]], A=[[1, 0], [0, 1]], b=[0, 0], laws=laws)
