@@ -294,6 +294,16 @@ def test_read_matrices_feed_a_unilateral_system(tmp_path, model):
     np.testing.assert_allclose(lam, system.modes().frequencies[:2], rtol=1e-10)
 
 
+def test_a_large_sparse_model_is_read_and_checked_by_its_sparse_factorisation(tmp_path):
+    beam = EulerBernoulliBeam(1100, cracks=[(550, 1)])   # N = 2201: M checked by the signs of its sparse LDLᵀ
+    scipy.sparse.save_npz(tmp_path / "M.npz", beam.M)
+    scipy.sparse.save_npz(tmp_path / "K.npz", beam.K)
+    matrices = read_matrices({"M": tmp_path / "M.npz", "K": tmp_path / "K.npz"})
+    _same(matrices["M"], beam.M)
+    _same(matrices["K"], beam.K)
+    assert beam == EulerBernoulliBeam(1100, cracks=[(550, "1")]) != EulerBernoulliBeam(1100, cracks=[(550, 2)])
+
+
 def _indefinite(n: int) -> scipy.sparse.csr_matrix:
     """Positive diagonal, one 2×2 block [[1, 2], [2, 1]] (eigenvalue −1) in the middle."""
     M = scipy.sparse.lil_matrix(scipy.sparse.identity(n))

@@ -223,6 +223,17 @@ class EulerBernoulliBeam:
         """
         return np.linspace(0.0, _exact_to_float(self.length), self.n_elements + 1)
 
+    def _key(self) -> tuple:
+        return (self.n_elements, self.length, self.E, self.I, self.rho, self.area, self.left, self.right, self.cracks)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, EulerBernoulliBeam):
+            return NotImplemented
+        return self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
+
     def __repr__(self) -> str:
         return (f"EulerBernoulliBeam(n_elements={self.n_elements}, {self.left}–{self.right}, N={self.n_dof}, "
                 f"cracks at nodes {[crack[0] for crack in self.cracks]})")
@@ -318,7 +329,8 @@ class EulerBernoulliBeam:
     def modes(self, count: int, *, sigma: float = 0.0) -> Modes:
         """The ``count`` lowest linear modes (nearest ``λ² = sigma``) by sparse shift-invert Lanczos.
 
-        See :func:`~lindstedt.problems.structures.sparse_modes`; ``count < N``.
+        See :func:`~lindstedt.problems.structures.sparse_modes` (``count < N``), and its notes: in float64 the
+        relative error of λ_k grows like ``eps (L/h)⁴`` (1e-3 at 5000 elements).
 
         Examples
         --------

@@ -371,6 +371,14 @@ def sparse_modes(M: Any, K: Any, count: int, *, sigma: float = 0.0) -> Modes:
     Modes
         ``(frequencies, shapes)``: λ increasing (shape ``(count,)``) and Φ column by column (``(N, count)``).
 
+    Notes
+    -----
+    Float64 limits the accuracy: the residual ``K φ − λ² M φ`` of a smooth mode cancels to ``eps · ‖K‖ ‖φ‖``,
+    so ``λ_k²`` carries a relative error of order ``eps · cond(K)`` whatever the solver.  For a beam of
+    ``n`` elements ``cond(K) ~ (L/h)⁴``: the first cantilever frequency was measured off by 7e-10 (relative)
+    at n = 128, 3e-7 at 512, 1e-5 at 2048 and 1e-3 at 5000 (10⁴ dof).  Fine meshes need the modes refined
+    with residuals in higher precision.
+
     Examples
     --------
     >>> import numpy as np, scipy.sparse
