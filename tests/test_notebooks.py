@@ -32,6 +32,7 @@ NAMES = (
     "fig4_8_numerical_nnm.ipynb",
     "forced_response.ipynb",
     "hertz_backbone.ipynb",
+    "peer_sdnd123.ipynb",
     "runtime_vs_error.ipynb",
     "validity_time.ipynb",
 )
@@ -52,6 +53,7 @@ PLOT_FUNCTIONS = {
     "validity_time.ipynb": {"convergence"},
     "runtime_vs_error.ipynb": set(),
     "forced_response.ipynb": {"frequency_response", "spectrum"},
+    "peer_sdnd123.ipynb": {"branch"},
 }
 #: the figures (image/png outputs) each executed notebook shows, at least
 FIGURES = {
@@ -63,6 +65,7 @@ FIGURES = {
     "validity_time.ipynb": 2,
     "runtime_vs_error.ipynb": 3,
     "forced_response.ipynb": 3,
+    "peer_sdnd123.ipynb": 1,
 }
 #: rich displays of results (the last expression of a cell): (mime type, fragments that one such output contains)
 DISPLAYS = {
@@ -83,6 +86,7 @@ DISPLAYS = {
         # FrequencyResponseCurve._repr_latex_: the equation and the closed-form first harmonic of (A cos θ − 1/5)_+
         ("text/latex", [r"\varepsilon F \cos \Omega t", r"\operatorname{acos}{\left(\frac{1}{5 A} \right)}"]),
     ],
+    "peer_sdnd123.ipynb": [("text/html", ['<table class="lindstedt">', "<b>NNMBranch: "])],
     "hertz_backbone.ipynb": [
         ("text/latex", ["Stretched contact arc", r"|u - b|^{3/2}"]),
         ("text/html", ['<table class="lindstedt">', "<b>StretchedArcSeries"]),
