@@ -134,7 +134,8 @@ def build_parser() -> argparse.ArgumentParser:
     expand.add_argument("--precision", type=int, default=30, help="decimal digits for non-polynomial f (default 30)")
 
     nnm = commands.add_parser("nnm", help="nonlinear normal mode of M X'' + K X + eps W (A X - b)_+ = 0 by strained coordinates")
-    nnm.add_argument("system", help="SYSTEM.json with keys M, K, A, b and optional W (nested lists, numbers or exact strings)")
+    nnm.add_argument("system", help="SYSTEM.json with keys M, K, A, b and optional W and laws (nested lists, numbers "
+                                         "or exact strings; laws: one f(u) per row of A, default Max(0, u))")
     nnm.add_argument("--mode", type=int, required=True, help="mode number j (1-based, increasing frequency)")
     nnm.add_argument("--a0", default=None, help="modal amplitude of mode j at release (expansion, or --numeric with the other modal coordinates free)")
     nnm.add_argument("--numeric", action="store_true", help="periodic orbit by shooting on the exact flow instead of the expansion")

@@ -28,7 +28,8 @@ def add_forced_parser(commands: Any, formats: tuple[str, ...], format_help: str)
         "forced", help="forced response of u'' + 2 zeta omega0 u' + omega0^2 u + eps f(u) = eps F cos(Omega t)"
     )
     forced.add_argument("f", help="the nonlinearity f(u), e.g. 'Max(0, u - 1/10)' or 'u**3'; or FORCED.json, an N-dof "
-                                  "system {\"system\": {M, K, A, b}, \"load\": P, and rayleigh, modal_damping or C}")
+                                  "system {\"system\": {M, K, A, b, optional W and laws: one law f(u) per row of A, default "
+                                  "Max(0, u)}, \"load\": P, and rayleigh, modal_damping or C}")
     forced.add_argument("--omega0", default="1", help="linear angular frequency omega0 > 0 (default 1)")
     forced.add_argument("--zeta", default="0", help="damping ratio zeta >= 0 (default 0)")
     forced.add_argument("--forcing", default="1", help="forcing amplitude F != 0; the load is eps F cos(Omega t) (default 1)")
