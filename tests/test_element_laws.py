@@ -109,3 +109,17 @@ def test_laws_are_read_by_the_one_parser_and_kept_in_json():
 def test_bad_laws_are_typed_errors(laws, error, words):
     with pytest.raises(error, match=words):
         UnilateralSystem(M=[[1, 0], [0, 1]], K=[[2, -1], [-1, 2]], A=[[1, 0], [0, 1]], b=[0, 0], laws=laws)
+
+
+def test_a_chain_takes_elements_of_any_law_between_any_two_masses():
+    chain = UnilateralSystem.chain(3, unilateral=[(2, "1/10")],
+                                   elements=[(0, 1, "u**3"), (1, None, "Max(0, u)**(3/2)", "1/5")])
+    assert chain.A.tolist() == [[0, 0, 1], [1, -1, 0], [0, 1, 0]]
+    assert chain.b.tolist() == [0.1, 0.0, 0.2]
+    assert [str(law) for law in chain.laws] == ["Max(0, u)", "u**3", "Max(0, u)**(3/2)"]
+    relative_gap = UnilateralSystem.chain(2, elements=[(0, 1, "Max(0, u)", "1/10")])
+    assert relative_gap.unilateral and relative_gap.A.tolist() == [[1, -1]]  # the exact flow's problem
+    for bad, words in (((0, 0, "u**3"), "two different masses"), ((0, 5, "u**3"), "0..2"),
+                       ((0, "u**3"), r"\(i, j, law\)")):
+        with pytest.raises(lindstedt.ProblemError, match=words):
+            UnilateralSystem.chain(3, elements=[bad])

@@ -271,6 +271,7 @@ class UnilateralSystem:
         *,
         mass: Any = 1,
         stiffness: Any = 1,
+        elements: Iterable[Sequence[Any]] = (),
     ) -> "UnilateralSystem":
         """Chain of equal masses joined by equal springs, both ends fixed to walls.
 
@@ -287,6 +288,10 @@ class UnilateralSystem:
             The unilateral springs; ``direction`` is +1 (default) or −1.
         mass, stiffness : number, optional
             Positive mass and spring constant (default 1).
+        elements : iterable of (i, j, law) or (i, j, law, gap)
+            Elements of any law f(u) of the 1-dof library between two masses: the force
+            ``ε f(X_i − X_j − gap)`` pushes mass j and pulls mass i (``j = None``: between mass i and the
+            ground).  They follow the unilateral springs in A.
 
         Examples
         --------
@@ -295,6 +300,9 @@ class UnilateralSystem:
         [[2.0, -1.0, 0.0], [-1.0, 2.0, -1.0], [0.0, -1.0, 2.0]]
         >>> chain.A.tolist(), chain.b.tolist()
         ([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0]], [0.0, 0.5])
+        >>> cubic = UnilateralSystem.chain(2, elements=[(0, 1, "u**3")])      # a cubic spring between the masses
+        >>> cubic.A.tolist(), cubic.laws
+        ([[1.0, -1.0]], (u**3,))
         """
         if isinstance(n_masses, bool) or not isinstance(n_masses, (int, np.integer)) or n_masses < 1:
             raise ProblemError(f"n_masses must be a positive integer, got {n_masses!r}")
@@ -332,7 +340,26 @@ class UnilateralSystem:
             row[int(index)] = sympy.Integer(direction)
             rows.append(row)
             gaps.append(_exact_scalar(gap, f"gap of unilateral spring {k}"))
-        return cls(M=M, K=K, A=rows if rows else sympy.zeros(0, n), b=gaps)
+        laws: list[Any] = [UNILATERAL] * len(rows)
+        for k, spec in enumerate(elements):
+            if isinstance(spec, (str, bytes)) or not isinstance(spec, Sequence) or len(spec) not in (3, 4):
+                raise ProblemError(f"element {k} must be (i, j, law) or (i, j, law, gap): the law f(u) acts on "
+                                   f"u = X_i − X_j − gap (j = None: the ground), got {spec!r}")
+            row = [sympy.Integer(0)] * n
+            for index, sign in ((spec[0], 1), (spec[1], -1)):
+                if index is None and sign == -1:
+                    continue
+                if isinstance(index, bool) or not isinstance(index, (int, np.integer)) or not 0 <= index < n:
+                    raise ProblemError(f"element {k}: a mass index must be an integer in 0..{n - 1} (masses are "
+                                       f"indexed from 0; the second may be None, the ground), got {index!r}")
+                row[int(index)] += sign
+            if all(entry == 0 for entry in row):
+                raise ProblemError(f"element {k} acts on X_{spec[0]} − X_{spec[1]} = 0: join two different masses")
+            rows.append(row)
+            gaps.append(_exact_scalar(spec[3] if len(spec) == 4 else 0, f"gap of element {k}"))
+            laws.append(spec[2])
+        unilateral_only = all(law is UNILATERAL for law in laws)
+        return cls(M=M, K=K, A=rows if rows else sympy.zeros(0, n), b=gaps, laws=None if unilateral_only else laws)
 
     @classmethod
     def one_dof(cls, omega0: Any, a: Any = 1, b: Any = 0) -> "UnilateralSystem":
