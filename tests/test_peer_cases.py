@@ -133,3 +133,75 @@ def test_sdnd123_the_peer_numbers_are_the_regularised_model(regularised):
     assert 300 < amplification < 800
     assert abs(energy_at_fs - E_CALC) / E_CALC < 2e-4, energy_at_fs
     assert abs(energy_at_fs - E_CALC) / E_CALC < amplification * 1e-6  # what the frequency's 1e-6 explains
+
+
+# NLvib example 03: M X'' + C X' + K X + 100 (x1 − 1)_+ e1 = 0.1 cos(Ω t) e2, M = I, K = [[1, −1], [−1, 2]], C = 0.03 K;
+# in lindstedt's form ε = 100, P = [0, 1/1000]. NLvib (HB, H = 21; shooting, 2^12 samples) shows turning points,
+# period doubling and Neimark–Sacker between Ω = 0.8 and 0.5, a stable period-one orbit at Ω ≈ 0.635 and one beyond
+# the Neimark–Sacker point at Ω ≈ 0.6 (its selected points, script lines 127–131). It prints no number; the
+# Python port's comparison report gives the peak of the HB curve (cases.json), set side by side in the report,
+# not asserted: its 0.15 % difference is not yet explained by an independent harmonic-balance study.
+NLVIB03 = CASES["nlvib_03_unilateral_spring"]
+K3 = np.asarray(NLVIB03["system"]["K"], dtype=float)
+C3 = 0.03 * K3
+
+
+def _rhs03(t: float, y: np.ndarray, omega: float) -> np.ndarray:
+    x, v = y[:2], y[2:]
+    contact = 100.0 * max(x[0] - 1.0, 0.0)
+    return np.r_[v, np.array([0.0, 0.1]) * np.cos(omega * t) - K3 @ x - C3 @ v - np.array([contact, 0.0])]
+
+
+def _run03(y0: np.ndarray, omega: float, periods: float, rtol: float = 1e-12, samples: np.ndarray | None = None,
+           max_step: float = np.inf):
+    """DOP853 from y0 over ``periods`` periods, restarted at every crossing of x1 = 1 (the kink located, so the
+    integrator's error estimate holds); returns the end state, or the states at the times ``samples``."""
+    crossing = lambda t, y, omega: y[0] - 1.0  # noqa: E731
+    end, t, y, values = periods * 2 * np.pi / omega, 0.0, np.asarray(y0, dtype=float), []
+    while True:
+        part = solve_ivp(_rhs03, (t, end), y, args=(omega,), method="DOP853", rtol=rtol, atol=1e-2 * rtol,
+                         events=crossing, dense_output=True, max_step=max_step)
+        if samples is not None:
+            values.extend(part.sol(samples[(samples >= t) & (samples <= part.t[-1])]).T)
+        if part.status != 1:
+            return np.array(values).T if samples is not None else part.y[:, -1]
+        t = part.t[-1] + 1e-12  # step off the switching surface (else the crossing is found again at once)
+        y = part.sol(t)
+
+
+@pytest.fixture(scope="module")
+def nlvib03() -> lindstedt.FrequencyResponse:
+    system = lindstedt.UnilateralSystem(M=NLVIB03["system"]["M"], K=NLVIB03["system"]["K"], A=NLVIB03["system"]["A"],
+                                        b=NLVIB03["system"]["b"])
+    forced = lindstedt.ForcedSystem(system, load=[0, "1/1000"], rayleigh=(0, "3/100"))
+    return lindstedt.frequency_response(forced, 0.8, 0.5, epsilon=float(NLVIB03["system"]["epsilon"]))
+
+
+def test_nlvib03_every_orbit_closes_under_an_independent_integration(nlvib03):
+    assert nlvib03.success
+    omegas = np.asarray(nlvib03.frequencies)
+    for k in range(0, len(omegas), 3):
+        y0 = np.asarray(nlvib03.states[k], dtype=float)
+        # an orbit grazing the gap (max x1 within 1e-3 of it) enters contact for a short time that an adaptive step
+        # could step over, the crossing unseen: small steps there
+        step = 2e-3 if abs(nlvib03.maxima[k][0] - 1.0) < 1e-3 else np.inf
+        fine = _run03(y0, omegas[k], 1, max_step=step)
+        coarse = _run03(y0, omegas[k], 1, rtol=1e-10, max_step=step)
+        integrator_error = float(np.max(np.abs(fine - coarse)))
+        assert np.max(np.abs(fine - y0)) <= max(integrator_error, 1e-10), (omegas[k], integrator_error)
+
+
+def test_nlvib03_the_bifurcations_nlvib_shows(nlvib03):
+    kinds = [(b.kind, b.frequency) for b in nlvib03.bifurcations]
+    assert [k for k, _ in kinds].count("period-doubling") == 2 and [k for k, _ in kinds].count("neimark-sacker") == 2
+    assert any(kind == "fold" and 0.75 < omega < 0.76 for kind, omega in kinds)   # the upper turning point
+    ns = sorted(omega for kind, omega in kinds if kind == "neimark-sacker")
+    assert ns[0] < 0.6 < ns[1] < 0.635                                            # NLvib's selected points 3 and 2
+    for target, stable in ((0.635, True), (0.6, False)):
+        orbit = lindstedt.forced_periodic_orbit(nlvib03.flow, target)
+        assert orbit.success and orbit.stable is stable, (target, orbit.message)
+        # independent: from the orbit slightly perturbed, 300 periods of DOP853 come back (stable) or drift away
+        y0 = np.asarray(orbit.state, dtype=float)
+        states = _run03(y0 + 1e-4, target, 300, rtol=1e-10, samples=2 * np.pi / target * np.arange(280, 301))
+        distance = float(np.max(np.abs(states - y0[:, None])))
+        assert (distance < 1e-6) if stable else (distance > 1e-2), (target, distance)
