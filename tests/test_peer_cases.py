@@ -10,11 +10,14 @@ frequency–energy pair of its branch. References, none of them the code under t
 
 * closed forms: the contact-onset energy ``E_g = ½ λ₂² (b₁ / |φ₂₁|)²`` and, below it, ω = λ₂ = (1 + √5)/2 exactly
   (the orbit never touches a stop: it is the linear mode);
-* the regularised ODE (code_aster's law, from its documentation of the source: ``f³/α² − 2 x f²/α + (x² − 1) f
-  + η x = 0``, the middle real root) integrated by scipy's DOP853 and shot to a symmetric periodic orbit at the
-  peer's energy, written in this file.
+* the regularised ODE (code_aster's law as read in its source, bibfor/nonlinear/mnlbil.F90: ``f³/α² − 2 x f²/α
+  + (x² − 1) f + η x = 0``, the middle real root) integrated by scipy's DOP853 and shot to a symmetric periodic
+  orbit at the peer's energy, written in this file.
 
 The branch itself against DOP853 is tests/test_nnm_trust.py; here only the peer's numbers are placed.
+
+NLvib example 03 (forced two-mass chain with a unilateral spring): the exact frequency response against DOP853 with
+the kink located, and the bifurcations NLvib shows, confirmed by long runs (see the comment above its tests).
 """
 
 from __future__ import annotations
@@ -87,11 +90,11 @@ def regularised() -> dict[str, float]:
 
 
 def test_sdnd123_the_regularised_law_is_a_smoothed_bilateral_stop():
-    # the law as transcribed: three real roots, the middle one → 0 in free flight and → α(|x| − 1) beyond the stops
+    # the law as transcribed: three real roots, the middle one → 0 in free flight, → α(|x| − 1) beyond the stops
     for x in (-1.6, -1.01, -0.5, 0.0, 0.3, 0.99, 1.0, 1.2, 2.0):
         roots = np.roots([1.0 / ALPHA**2, -2.0 * x / ALPHA, x * x - 1.0, ETA * x])
         assert np.max(np.abs(roots.imag)) == 0.0
-    assert _regularised_force(0.5) == pytest.approx(ETA * 0.5 / (1 - 0.25), rel=1e-3)  # f ≈ η x/(1 − x²) in free flight
+    assert _regularised_force(0.5) == pytest.approx(ETA * 0.5 / (1 - 0.25), rel=1e-3)  # f ≈ η x/(1 − x²): free
     assert _regularised_force(1.5) == pytest.approx(ALPHA * 0.5, rel=1e-3)
     assert _regularised_force(-1.5) == pytest.approx(-ALPHA * 0.5, rel=1e-3)
 
@@ -135,12 +138,12 @@ def test_sdnd123_the_peer_numbers_are_the_regularised_model(regularised):
     assert abs(energy_at_fs - E_CALC) / E_CALC < amplification * 1e-6  # what the frequency's 1e-6 explains
 
 
-# NLvib example 03: M X'' + C X' + K X + 100 (x1 − 1)_+ e1 = 0.1 cos(Ω t) e2, M = I, K = [[1, −1], [−1, 2]], C = 0.03 K;
-# in lindstedt's form ε = 100, P = [0, 1/1000]. NLvib (HB, H = 21; shooting, 2^12 samples) shows turning points,
-# period doubling and Neimark–Sacker between Ω = 0.8 and 0.5, a stable period-one orbit at Ω ≈ 0.635 and one beyond
-# the Neimark–Sacker point at Ω ≈ 0.6 (its selected points, script lines 127–131). It prints no number; the
-# Python port's comparison report gives the peak of the HB curve (cases.json), set side by side in the report,
-# not asserted: its 0.15 % difference is not yet explained by an independent harmonic-balance study.
+# NLvib example 03: M X'' + C X' + K X + 100 (x1 − 1)_+ e1 = 0.1 cos(Ω t) e2, M = I, K = [[1, −1], [−1, 2]],
+# C = 0.03 K; in lindstedt's form ε = 100, P = [0, 1/1000]. NLvib (HB, H = 21; shooting, 2^12 samples) shows
+# turning points, period doubling and Neimark–Sacker between Ω = 0.8 and 0.5, a stable period-one orbit at
+# Ω ≈ 0.635 and one beyond the Neimark–Sacker point at Ω ≈ 0.6 (its selected points, script lines 127–131). It
+# prints no number; the Python port's comparison report gives the peak of the HB curve (cases.json), set side by
+# side there, not asserted: its 0.15 % difference is not yet explained by an independent harmonic-balance study.
 NLVIB03 = CASES["nlvib_03_unilateral_spring"]
 K3 = np.asarray(NLVIB03["system"]["K"], dtype=float)
 C3 = 0.03 * K3
