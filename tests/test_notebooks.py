@@ -145,7 +145,11 @@ def _client_modules():
     return nbclient, nbformat
 
 
-@pytest.mark.parametrize("name", NAMES)
+#: notebooks taking 5–20 s each: executed by `pytest -m slow` (CI runs it) and by every build of the docs site
+HEAVY = ("backbone.ipynb", "hertz_backbone.ipynb", "peer_sdnd123.ipynb")
+
+
+@pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.slow) if name in HEAVY else name for name in NAMES])
 def test_notebook_executes(name, monkeypatch):
     nbclient, nbformat = _client_modules()
     monkeypatch.setenv("MPLBACKEND", INLINE_BACKEND)

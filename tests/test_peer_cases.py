@@ -180,6 +180,7 @@ def nlvib03() -> lindstedt.FrequencyResponse:
     return lindstedt.frequency_response(forced, 0.8, 0.5, epsilon=float(NLVIB03["system"]["epsilon"]))
 
 
+@pytest.mark.slow  # 9–13 s: the branch and its independent DOP853 closures
 def test_nlvib03_every_orbit_closes_under_an_independent_integration(nlvib03):
     assert nlvib03.success
     omegas = np.asarray(nlvib03.frequencies)
@@ -194,6 +195,7 @@ def test_nlvib03_every_orbit_closes_under_an_independent_integration(nlvib03):
         assert np.max(np.abs(fine - y0)) <= max(integrator_error, 1e-10), (omegas[k], integrator_error)
 
 
+@pytest.mark.slow  # 9–13 s: the branch and its independent DOP853 closures
 def test_nlvib03_the_bifurcations_nlvib_shows(nlvib03):
     kinds = [(b.kind, b.frequency) for b in nlvib03.bifurcations]
     assert [k for k, _ in kinds].count("period-doubling") == 2 and [k for k, _ in kinds].count("neimark-sacker") == 2
