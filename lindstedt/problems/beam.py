@@ -98,10 +98,9 @@ class EulerBernoulliBeam:
     dofs : tuple of str
         The label of each degree of freedom, in order (see the module notes): ``"w3"``, ``"theta3"``,
         ``"theta3-"``, ``"theta3+"``.
-    M, K : scipy.sparse.csr_matrix
-        The assembled mass and stiffness matrices (floats correctly rounded from the exact assembly).
-    A : scipy.sparse.csr_matrix, shape (m, N)
-        One row per crack, ``direction · (e(θ⁺) − e(θ⁻))``; ``b`` (numpy array) holds the gaps.
+
+    The assembled ``M``, ``K`` (floats correctly rounded from the exact assembly), the crack rows ``A`` and their
+    gaps ``b`` are the properties below.
 
     Raises
     ------
