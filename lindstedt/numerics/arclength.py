@@ -389,9 +389,9 @@ class Arclength(Stepper):
     def land(self, value: float, guess: np.ndarray) -> tuple[Any, int, str]:
         """(the point at λ = value solved from the guess of z or None, Newton iterations, message)."""
 
+    @abstractmethod
     def unknowns_of(self, point: Any, value: float) -> np.ndarray:
         """The unknowns w = (z, λ) of a point."""
-        raise NotImplementedError
 
     def check_value(self, value: float, iterations: int) -> Attempt | None:
         """A rejection of a corrected λ before anything else (e.g. behind start), else None."""

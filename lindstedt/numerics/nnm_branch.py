@@ -399,8 +399,11 @@ class _NNMArclength(_NNMStepper, Arclength):
         return (f"the branch turns vertical towards mode {mode}: internal resonance λ_{mode} = {lam:.6g} ≈ "
                 f"{harmonic} ω (ω = {result.frequency:.6g})")
 
+    def unknowns_of(self, point: NNMResult, value: float) -> np.ndarray:
+        return np.r_[_unknowns_of(self.problem, point), value]
+
     def begin(self, first: NNMResult, value: float) -> str | None:
-        failure = self.start_at(np.r_[_unknowns_of(self.problem, first), value], first)
+        failure = super().begin(first, value)
         if failure:
             return failure
         if self.minimum_start_slope is not None and self.slope(self.tangent) < self.minimum_start_slope:
