@@ -518,6 +518,41 @@ class UnilateralSystem:
         """
         return self._modes
 
+    @cached_property
+    @locked  # sympy: integration and lambdify
+    def _element_laws_numeric(self) -> tuple[tuple[Any, ...], tuple[Any, ...] | None]:
+        """The laws f_i and their potentials V_i(u) = ∫_0^u f_i as NumPy functions (potentials None when one has
+        no closed form)."""
+        s = sympy.Symbol("s", real=True)
+        forces, potentials = [], []
+        for law in self.laws:
+            forces.append(sympy.lambdify(LAW_VARIABLE, law, "numpy"))
+            potential = sympy.integrate(law.subs(LAW_VARIABLE, s).rewrite(sympy.Piecewise), (s, 0, LAW_VARIABLE))
+            potentials.append(None if potential.has(sympy.Integral) else sympy.lambdify(LAW_VARIABLE, potential, "numpy"))
+        return tuple(forces), (None if any(p is None for p in potentials) else tuple(potentials))
+
+    def _element_forces(self, gaps: np.ndarray) -> np.ndarray:
+        """``f_i(g_i)`` for gaps of shape (..., m)."""
+        if self.unilateral:
+            return np.maximum(gaps, 0.0)
+        forces, _ = self._element_laws_numeric
+        with np.errstate(invalid="ignore", divide="ignore"):  # NumPy evaluates every branch of a Piecewise
+            return np.stack([np.broadcast_to(f(gaps[..., i]), gaps.shape[:-1]) for i, f in enumerate(forces)],
+                            axis=-1).astype(float)
+
+    def _element_potentials(self, gaps: np.ndarray) -> np.ndarray:
+        """``V_i(g_i)`` for gaps of shape (..., m)."""
+        if self.unilateral:
+            return 0.5 * np.maximum(gaps, 0.0) ** 2
+        _, potentials = self._element_laws_numeric
+        if potentials is None:
+            raise UnsupportedNonlinearityError(
+                f"the energy needs the potential ∫f of every law, and one of [{', '.join(map(str, self.laws))}] has "
+                "no closed form; use a law whose antiderivative sympy finds, or the modal amplitude")
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.stack([np.broadcast_to(V(gaps[..., i]), gaps.shape[:-1]) for i, V in enumerate(potentials)],
+                            axis=-1).astype(float)
+
     def gaps(self, x: Any) -> np.ndarray:
         """Gap functions ``A X − b`` (positive: spring engaged); ``x`` has shape (..., N).
 
@@ -530,20 +565,23 @@ class UnilateralSystem:
         return positions @ self.A.T - self.b
 
     def acceleration(self, x: Any, epsilon: float) -> np.ndarray:
-        """``X'' = −M⁻¹ (K X + ε W (A X − b)_+)`` for positions of shape (..., N).
+        """``X'' = −M⁻¹ (K X + ε W f(A X − b))`` for positions of shape (..., N) (f the elements' laws).
 
         Examples
         --------
         >>> UnilateralSystem.one_dof(1).acceleration([2.0], 0.5).tolist()
         [-3.0]
         """
-        self.require_unilateral("acceleration()")
         positions = np.asarray(x, dtype=float)
-        force = positions @ self.K.T + epsilon * np.maximum(self.gaps(positions), 0.0) @ self.W.T
+        force = positions @ self.K.T + epsilon * self._element_forces(self.gaps(positions)) @ self.W.T
         return -np.linalg.solve(self.M, force.reshape(-1, self.n_dof).T).T.reshape(force.shape)
 
     def energy(self, x: Any, v: Any, epsilon: float) -> np.ndarray | float:
-        """``E = ½ X'ᵀ M X' + ½ Xᵀ K X + ½ ε Σ_i (A_i X − b_i)_+²`` (requires ``W = Aᵀ``).
+        """``E = ½ X'ᵀ M X' + ½ Xᵀ K X + ε Σ_i V_i(A_i X − b_i)`` (requires ``W = Aᵀ``).
+
+        ``V_i(u) = ∫_0^u f_i`` is the potential of element i's law (``½ u_+²`` for a unilateral spring), integrated
+        exactly once per system; a law whose potential has no closed form raises
+        :class:`~lindstedt.UnsupportedNonlinearityError`.
 
         ``x`` and ``v`` have shape (..., N); the result has shape (...).
 
@@ -552,14 +590,13 @@ class UnilateralSystem:
         >>> UnilateralSystem.one_dof(1).energy([2.0], [1.0], 0.5)
         3.5
         """
-        self.require_unilateral("energy()")
         if not self.symmetric_coupling:
             raise ProblemError("the energy E is conserved only for W = Aᵀ; this system has W ≠ Aᵀ")
         positions = np.asarray(x, dtype=float)
         velocities = np.asarray(v, dtype=float)
         kinetic = 0.5 * np.einsum("...i,ij,...j->...", velocities, self.M, velocities)
         potential = 0.5 * np.einsum("...i,ij,...j->...", positions, self.K, positions)
-        contact = 0.5 * epsilon * np.sum(np.maximum(self.gaps(positions), 0.0) ** 2, axis=-1)
+        contact = epsilon * np.sum(self._element_potentials(self.gaps(positions)), axis=-1)
         total = kinetic + potential + contact
         return float(total) if np.ndim(total) == 0 else total
 
