@@ -129,3 +129,16 @@ def rounded_coefficients(results: list[tuple[mpmath.mpf, mpmath.mpf]], precision
     results = [(value, error + abs(value) * mpmath.mpf(10) ** (-precision)) for value, error in results]
     with workdps(precision):
         return [(+value, +error) for value, error in results]
+
+
+def _checked_expression(expression: sympy.Basic) -> tuple[sympy.Expr, sympy.Symbol]:
+    """f with its variable u; any other symbol is refused (the references evaluate numbers only)."""
+    free = expression.free_symbols
+    variables = [symbol for symbol in free if symbol.name == "u"]
+    others = sorted(symbol.name for symbol in free if symbol.name != "u")
+    if others:
+        raise ParameterError(
+            f"f(u) = {expression} contains the symbols {others} besides u; "
+            "substitute numeric values for them (expr.subs(...)) before calling"
+        )
+    return expression, variables[0] if variables else sympy.Symbol("u")

@@ -28,7 +28,7 @@ import mpmath
 import sympy
 from sympy.functions.elementary.integers import RoundFunction
 
-from .._errors import ParameterError, ProblemError, UnsupportedNonlinearityError
+from .._errors import ProblemError, UnsupportedNonlinearityError
 from ..problems.parsing import parse_expression, parse_real
 from .arguments import real_parameter
 
@@ -431,19 +431,6 @@ class _PiecewisePotential:
                 piece = following
         self._cache[key] = (constants, blocked)
         return constants, blocked
-
-
-def _checked_expression(expression: sympy.Basic) -> tuple[sympy.Expr, sympy.Symbol]:
-    """f with its variable u (other symbols are refused, as by :class:`_Potential`)."""
-    free = expression.free_symbols
-    variables = [symbol for symbol in free if symbol.name == "u"]
-    others = sorted(symbol.name for symbol in free if symbol.name != "u")
-    if others:
-        raise ParameterError(
-            f"f(u) = {expression} contains the symbols {others} besides u; "
-            "substitute numeric values for them (expr.subs(...)) before calling"
-        )
-    return expression, variables[0] if variables else sympy.Symbol("u")
 
 
 def _needs_pieces(expression: sympy.Expr, variable: sympy.Symbol) -> bool:

@@ -36,10 +36,9 @@ import mpmath
 import sympy
 
 from .._precision import locked, workdps
-from .arguments import Nonlinearity, omega0_parameter, real_parameter, validate_precision
+from .arguments import Nonlinearity, _checked_expression, omega0_parameter, real_parameter, validate_precision
 from .breakpoints import (
     _PiecewisePotential,
-    _checked_expression,
     _exact_breakpoints,
     _needs_pieces,
     _piecewise_from_callable,

@@ -28,8 +28,8 @@ from typing import Any
 import mpmath
 import sympy
 
-from .._errors import ConvergenceError, ParameterError, ProblemError
-from .arguments import Nonlinearity
+from .._errors import ConvergenceError, ProblemError
+from .arguments import Nonlinearity, _checked_expression
 
 _MAXIMUM_TRAPEZOID_NODES = 2**13
 _INITIAL_TRAPEZOID_NODES = 16
@@ -43,16 +43,7 @@ class _Potential:
 
     def __init__(self, nonlinearity: Nonlinearity) -> None:
         if isinstance(nonlinearity, sympy.Basic):
-            expression = nonlinearity
-            free = expression.free_symbols
-            variables = [symbol for symbol in free if symbol.name == "u"]
-            others = sorted(symbol.name for symbol in free if symbol.name != "u")
-            if others:
-                raise ParameterError(
-                    f"f(u) = {expression} contains the symbols {others} besides u; "
-                    "substitute numeric values for them (expr.subs(...)) before calling"
-                )
-            variable = variables[0] if variables else sympy.Symbol("u")
+            expression, variable = _checked_expression(nonlinearity)
             dummy = sympy.Dummy("s")
             self._force = sympy.lambdify(variable, expression, modules="mpmath")
             antiderivative = sympy.integrate(expression.subs(variable, dummy), (dummy, 0, variable))
