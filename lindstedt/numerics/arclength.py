@@ -60,8 +60,6 @@ KINDS = ("fold", "branch-point", "period-doubling", "neimark-sacker")
 #: above the second share when bracketed, found a jump of the test, not a zero (a smooth zero is approached
 #: superlinearly: ~1e-7 of them when bracketed to 1e-9 of a step)
 _JUMP_PROBES, _JUMP_RATIO, _ZERO_RATIO = 8, 1e-3, 1e-5
-#: the kinds whose test functions read the Floquet multipliers
-_MULTIPLIER_KINDS = ("period-doubling", "neimark-sacker")
 
 
 # --------------------------------------------------------------------------- #
@@ -351,9 +349,8 @@ class Arclength(Stepper):
     non-trivial Floquet multipliers of a point), :meth:`land` (a solve at fixed λ), :meth:`boundary` (where the
     range ends), :meth:`screen` (branch-specific checks of a verified point: may reject, end or jump), and
     :meth:`assemble`.  The attributes ``predictor_error``, ``max_turn`` (the cosine below which the tangent
-    turned too much), ``step_tol`` (the corrector's step convergence), ``conservative`` (no Neimark–Sacker
-    test) and ``multipliers_need_point`` (the multipliers come from the verified point, not the residual's
-    evaluation) set the method.
+    turned too much), ``step_tol`` (the corrector's step convergence) and ``conservative`` (no Neimark–Sacker
+    test) set the method.
     """
 
     name = "arclength"
@@ -363,7 +360,6 @@ class Arclength(Stepper):
     max_turn = 0.9
     step_tol: float | None = None
     conservative = False
-    multipliers_need_point = False
     locate_tol = 1e-9
     tol = 1e-10
     max_iterations = 10
@@ -424,9 +420,8 @@ class Arclength(Stepper):
         return None
 
     @abstractmethod
-    def bifurcation(self, kind: str, w: np.ndarray, point: Any, evaluation: Evaluation, test: float,
-                    index: int) -> Any:
-        """The record of a special point located at w (its point if verified, its evaluation), None to drop it."""
+    def bifurcation(self, kind: str, w: np.ndarray, evaluation: Evaluation, test: float, index: int) -> Any:
+        """The record of a special point located at w (with the residual's evaluation there), None to drop it."""
 
     # ------------------------------------------------------------ machinery
     def corrector(self, base: np.ndarray, scales: np.ndarray, unit: np.ndarray, sigma: float, *,
@@ -484,7 +479,12 @@ class Arclength(Stepper):
                                        evaluation.jacobian * self.scales[None, :], conservative=self.conservative)
         return None
 
+    #: the step under way: (w, scales, tangent, corrector outcome, point, tests, base index, λ-extent) of the point
+    #: an accepted attempt takes; None when the attempt is not a regular step (a landing at the end of the range)
+    pending: tuple | None = None
+
     def advance(self, points: list[Any], values: list[float]) -> Attempt:
+        self.pending = None
         w, scales, unit, h = self.w, self.scales, self.tangent, self.step
         outcome = self.corrector(w, scales, unit, h)
         iterations = outcome.iterations
@@ -530,13 +530,9 @@ class Arclength(Stepper):
         new_scales = self.scales_of(candidate, inner)
         previous = self.tangent * self.scales / new_scales
         new_tangent = tangent(inner.jacobian, new_scales, previous / np.linalg.norm(previous), self.direction)
-        point = None
-        if self.multipliers_need_point:
-            point, _ = self.verify(candidate, outcome)
-        if point is not None or not self.multipliers_need_point:
-            tests = bifurcation_tests(self.multipliers(point, inner), new_tangent, inner.jacobian * new_scales[None, :],
-                                   conservative=self.conservative)
-            self.search(self.tests, tests, h, len(values) - 1, within=target)
+        tests = bifurcation_tests(self.multipliers(None, inner), new_tangent, inner.jacobian * new_scales[None, :],
+                                  conservative=self.conservative)
+        self.search(self.tests, tests, h, len(values) - 1, within=target)
         fraction = (target - values[-1]) / (float(candidate[-1]) - values[-1]) if candidate[-1] != values[-1] else 1.0
         guess = w[:-1] + fraction * (candidate[:-1] - w[:-1])
         point, more, message = self.land(target, guess)
@@ -569,12 +565,12 @@ class Arclength(Stepper):
         found = self.locate(bracket.kind, bracket.f0, bracket.f1, bracket.h)
         if found is None:
             return None
-        (w, point, evaluation), test = found
+        (w, evaluation), test = found
         if not self.admissible(float(w[-1]), bracket.within):
             return None
-        return self.bifurcation(bracket.kind, w, point, evaluation, test, bracket.index)
+        return self.bifurcation(bracket.kind, w, evaluation, test, bracket.index)
 
-    def locate(self, kind: str, f0: float, f1: float, h: float) -> tuple[tuple[np.ndarray, Any, Evaluation], float] | None:
+    def locate(self, kind: str, f0: float, f1: float, h: float) -> tuple[tuple[np.ndarray, Evaluation], float] | None:
         """The special point of ``kind`` on the step from self.w: regula falsi on its test along the arclength."""
         base, scales, unit = self.w, self.scales, self.tangent
         known: list[tuple[float, np.ndarray]] = [(0.0, base)]  # corrected points of this step: warm starts
@@ -587,20 +583,15 @@ class Arclength(Stepper):
                 return None
             known.append((sigma, outcome.unknowns))
             inner = outcome.last.data
-            point = None
-            if self.multipliers_need_point and kind in _MULTIPLIER_KINDS:  # the others need no verified orbit
-                point, _ = self.verify(outcome.unknowns, outcome)
-                if point is None:
-                    return None
             local = tangent(inner.jacobian, scales, unit, self.direction)
-            tests = bifurcation_tests(self.multipliers(point, inner), local, inner.jacobian * scales[None, :],
-                                   conservative=self.conservative)
-            return tests[kind], (outcome.unknowns, point, inner)
+            tests = bifurcation_tests(self.multipliers(None, inner), local, inner.jacobian * scales[None, :],
+                                      conservative=self.conservative)
+            return tests[kind], (outcome.unknowns, inner)
 
         return locate_kind(kind, f0, f1, h, probe, tol=self.locate_tol)
 
     def accept(self, attempt: Attempt) -> None:
-        if attempt.complete and attempt.point is not self.pending_point():
+        if self.pending is None:
             return  # landed at the end of the range: its special points were searched by finish_at
         candidate, scales, unit, outcome, point, tests, index, _ = self.pending
         self.search(self.tests, tests, self.step, index)
@@ -609,10 +600,6 @@ class Arclength(Stepper):
         smooth = self.smooth_step(point)
         self.w, self.scales, self.tangent, self.last, self.tests = candidate, scales, unit, point, tests
         self.step = min(max(self.step * step_factor(outcome, self.predictor_error, smooth), self.h_min), self.h_max)
-
-    def pending_point(self) -> Any:
-        pending = getattr(self, "pending", None)
-        return None if pending is None else pending[4]
 
     def smooth_step(self, point: Any) -> bool:
         """Whether the residual was smooth over the step to ``point`` (the step may grow)."""

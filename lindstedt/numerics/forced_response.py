@@ -159,7 +159,7 @@ class _ForcedBranch(Arclength):
         return (f"the period-{self.count.periods} branch rejoins the period-{half} branch between {self.parameter} = "
                 f"{values[-1]:.8g} and {float(w[-1]):.8g} (another period doubling)")
 
-    def bifurcation(self, kind: str, w: np.ndarray, point: Any, evaluation: Evaluation, test: float,
+    def bifurcation(self, kind: str, w: np.ndarray, evaluation: Evaluation, test: float,
                     index: int) -> Bifurcation | None:
         multipliers = np.linalg.eigvals(evaluation.data.d_state)
         if kind == "neimark-sacker":

@@ -349,10 +349,9 @@ class _NNMArclength(_NNMStepper, Arclength):
     def smooth_step(self, point: NNMResult) -> bool:
         return point.contact_springs == self.last.contact_springs
 
-    def bifurcation(self, kind: str, w: np.ndarray, point: NNMResult | None, evaluation: Evaluation, test: float,
+    def bifurcation(self, kind: str, w: np.ndarray, evaluation: Evaluation, test: float,
                     index: int) -> Bifurcation | None:
-        if point is None:
-            point, _ = self.verify(w, NewtonOutcome(True, "", w, 0))
+        point, _ = self.verify(w, NewtonOutcome(True, "", w, 0))  # the located orbit, over one full period
         if point is None or point.contact_springs != self.last.contact_springs:
             return None
         return Bifurcation(kind, point.frequency, np.abs(point.release_position),
@@ -426,7 +425,7 @@ class _NNMArclength(_NNMStepper, Arclength):
     # ------------------------------------------------------------ one step
     def advance(self, points: list[NNMResult], values: list[float]) -> Attempt:
         if self.rescue is not None:  # the step collapsed: step across instead of shrinking to nothing
-            reason, self.rescue = self.rescue, None
+            reason, self.rescue, self.pending = self.rescue, None, None
             return self.jump(0, reason, collapse=True)
         return super().advance(points, values)
 
@@ -487,8 +486,8 @@ class _NNMArclength(_NNMStepper, Arclength):
 
     def accept(self, attempt: Attempt) -> None:
         _NNMStepper.accept(self, attempt)
-        if attempt.complete and attempt.point is not self.pending_point():
-            return
+        if self.pending is None:
+            return  # landed on stop (by a corrector's step or a jump)
         candidate, scales, unit, outcome, result, tests, _, extent = self.pending
         contact_changed = result.contact_springs != self.last.contact_springs
         if not attempt.jumped and tests is not None:
