@@ -305,8 +305,8 @@ class SmoothForcedFlow:
             M_inv = np.linalg.inv(system.M)
             self._Km, self._Cm, self._Pm = M_inv @ system.K, M_inv @ problem.C, M_inv @ problem.P
             A = np.array(system.A, dtype=float).reshape(-1, self.n_dof)
-            laws: dict[Any, _ScalarLaw] = {}  # one lambdified law per distinct law
-            elements = [laws.setdefault(law, _ScalarLaw(law, LAW_VARIABLE)) for law in system.laws]
+            laws = {law: _ScalarLaw(law, LAW_VARIABLE) for law in set(system.laws)}  # lambdified once per distinct law
+            elements = [laws[law] for law in system.laws]
             self._elements = _Elements(elements, A, np.array(system.b, dtype=float).reshape(-1),
                                        M_inv @ np.array(system.W, dtype=float).reshape(self.n_dof, -1))
             self.breakpoints = ()
