@@ -22,6 +22,7 @@ import numpy as np
 
 from .._errors import LindstedtError, ParameterError, ProblemError
 from ..problems.forced import ForcedOscillator, ForcedSystem
+from ..problems.system import UnilateralSystem
 
 __all__ = ["PeriodMap", "PeriodMapValue", "linear_frequency_bounds", "real_argument"]
 
@@ -81,7 +82,7 @@ class PeriodMap(Protocol):
 
 def linear_frequency_bounds(problem: Any, epsilon: float, slopes: Sequence[float] = ()) -> tuple[float, float] | None:
     """(lowest, highest) frequency of the linear pieces of a forced problem, ``ω² = eig(M⁻¹(K + ε·slope))``: for an
-    oscillator ``ω0² + ε·slope`` over 0 and its law's ``slopes``, for a system K and K + ε W diag(s) A with the
+    oscillator ``ω0² + ε·slope`` over 0 and its law's ``slopes``, for a system (forced or free) K and K + ε W diag(s) A with the
     steepest slope s of each element's law (``slopes``, one per element; 1 for unilateral springs); None when
     they cannot be formed (symbols left, a singular M).  A square beyond the float range is an infinite frequency.
 
@@ -97,8 +98,8 @@ def linear_frequency_bounds(problem: Any, epsilon: float, slopes: Sequence[float
         if isinstance(problem, ForcedOscillator):
             omega0 = problem.numeric_coefficients()[0]
             squares = [omega0 * omega0 + epsilon * slope for slope in (0.0, *slopes)]
-        elif isinstance(problem, ForcedSystem):
-            s = problem.system
+        elif isinstance(problem, (ForcedSystem, UnilateralSystem)):
+            s = problem.system if isinstance(problem, ForcedSystem) else problem
             A = np.array(s.A, dtype=float).reshape(-1, s.n_dof)
             W = np.array(s.W, dtype=float).reshape(s.n_dof, -1)
             steepest = np.asarray(slopes, dtype=float) if len(slopes) == A.shape[0] else np.ones(A.shape[0])

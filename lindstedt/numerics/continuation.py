@@ -158,7 +158,7 @@ _NEAR_LINEAR = 0.25
 def _near_linear(problem: NNMShooting, result: NNMResult, guess: np.ndarray) -> bool:
     """Whether a verified orbit is the linear mode itself (ε = 0, or no switch and no spring engaged at the release
     point) or within ``_NEAR_LINEAR`` of the linear-mode guess in period and release position."""
-    if result.epsilon == 0.0 or (result.n_switches == 0
+    if result.epsilon == 0.0 or (problem.system.unilateral and result.n_switches == 0
                                  and not np.any(problem.system.gaps(result.release_position) > 0)):
         return True
     x0, _, period = problem.split(guess)

@@ -48,7 +48,7 @@ from .._errors import ConvergenceError, ProblemError, UnsupportedNonlinearityErr
 from ..limits import checkpoint
 from .._precision import locked
 from ..problems.forced import ForcedOscillator, ForcedSystem, check_forcing_frequency
-from ..problems.system import LAW_VARIABLE
+from ..problems.system import LAW_VARIABLE, UnilateralSystem
 from ._period_map import PeriodMapValue, linear_frequency_bounds, real_argument
 
 __all__ = ["SmoothForcedFlow"]
@@ -144,6 +144,12 @@ class _ScalarLaw:
             polynomial = sympy.Poly(piece, u) if piece.is_polynomial(u) else None
             self.linear.append((float(polynomial.coeff_monomial(u)), float(polynomial.coeff_monomial(1)))
                                if polynomial is not None and polynomial.degree() <= 1 else None)
+
+    def jumps_at(self, index: int) -> bool:
+        """Whether f jumps at breakpoint ``index`` (its two pieces differ there: a Heaviside, a sign)."""
+        point = self.breakpoints[index]
+        left, right = self.pieces[index][0](point), self.pieces[index + 1][0](point)
+        return not abs(left - right) <= 1e-12 * (1.0 + abs(left) + abs(right))
 
     def region(self, u: float, v: float) -> int:
         """Index of the interval holding u (on a breakpoint: the one v moves into)."""
@@ -299,11 +305,15 @@ class SmoothForcedFlow:
                 np.array([forcing])
             self.breakpoints = tuple(law.breakpoints)
             slopes = [float(slope(point)) for _, slope, point in law.pieces]
-        elif isinstance(problem, ForcedSystem):
-            system = problem.system
+        elif isinstance(problem, (ForcedSystem, UnilateralSystem)):
+            system = problem.system if isinstance(problem, ForcedSystem) else problem
             self.n_dof = system.n_dof
             M_inv = np.linalg.inv(system.M)
-            self._Km, self._Cm, self._Pm = M_inv @ system.K, M_inv @ problem.C, M_inv @ problem.P
+            self._Km = M_inv @ system.K
+            if isinstance(problem, ForcedSystem):
+                self._Cm, self._Pm = M_inv @ problem.C, M_inv @ problem.P
+            else:  # free: no damping, no load (the flow of the NNMs)
+                self._Cm, self._Pm = np.zeros((self.n_dof, self.n_dof)), np.zeros(self.n_dof)
             A = np.array(system.A, dtype=float).reshape(-1, self.n_dof)
             laws = {law: _ScalarLaw(law, LAW_VARIABLE) for law in set(system.laws)}  # lambdified once per distinct law
             elements = [laws[law] for law in system.laws]
@@ -313,7 +323,8 @@ class SmoothForcedFlow:
             slopes = [max(abs(float(slope(point))) for _, slope, point in law.pieces) for law in elements]
         else:
             raise ProblemError(
-                f"problem must be a ForcedOscillator or a ForcedSystem (lindstedt.problems.forced), got {type(problem).__name__}")
+                f"problem must be a ForcedOscillator, a ForcedSystem (lindstedt.problems.forced) or a free UnilateralSystem, "
+                f"got {type(problem).__name__}")
         # one oscillator runs a scalar kernel of the same field: 2-4x fewer Python operations per step (measured
         # against the N-dof kernel at N = 1), the form of every benchmark of one degree of freedom
         self._scalar = self.n_dof == 1 and len(self._elements.laws) == 1 and isinstance(problem, ForcedOscillator)
@@ -357,8 +368,10 @@ class SmoothForcedFlow:
         n = self.n_dof
         return self._elements.region(z[:n], z[n:])
 
-    def _fields(self, region: tuple[int, ...], frequency: float, scale: float, sensitivity: bool) -> Callable:
-        """The right-hand side of (z, Y) on one region (Y the 2N × (2N + 2) sensitivity block)."""
+    def _fields(self, region: tuple[int, ...], frequency: float, scale: float, sensitivity: bool,
+                epsilon_column: bool = False) -> Callable:
+        """The right-hand side of (z, Y) on one region (Y the 2N × (2N + 2) sensitivity block: ∂z/∂z0, ∂z/∂Ω and
+        ∂z/∂s, or with ``epsilon_column`` ∂z/∂ε in place of ∂z/∂s — its forcing ``s P cos(Ω t) − M⁻¹ Σ_i w_i f_i``)."""
         eps, n = self.epsilon, self.n_dof
         if self._scalar:
             value, slope, _ = self._elements.laws[0].pieces[region[0]]
@@ -392,6 +405,9 @@ class SmoothForcedFlow:
 
             def restoring(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
                 return Km @ x - offset, Km
+
+            def nonlinear(x: np.ndarray) -> np.ndarray:
+                return affine[0] @ x - affine[1]
         else:  # the laws' analytic pieces: M⁻¹(K X + ε Σ_i w_i f_i(u_i)) and its Jacobian K + ε Σ_i w_i f_i'(u_i) a_iᵀ
             pieces = [law.pieces[r] for law, r in zip(elements.laws, region)]
             A, b, MW, K = elements.A, elements.b, elements.MW, self._Km
@@ -401,6 +417,9 @@ class SmoothForcedFlow:
                 forces = np.array([value(ui) for (value, _, _), ui in zip(pieces, u)])
                 slopes = np.array([slope(ui) for (_, slope, _), ui in zip(pieces, u)])
                 return K @ x + eps * (MW @ forces), K + eps * (MW * slopes) @ A
+
+            def nonlinear(x: np.ndarray) -> np.ndarray:
+                return MW @ np.array([value(ui) for (value, _, _), ui in zip(pieces, A @ x - b)])
 
         def system(t: float, y: np.ndarray) -> np.ndarray:
             x, v = y[:n], y[n:2 * n]
@@ -414,7 +433,10 @@ class SmoothForcedFlow:
             dY[:n] = Y[n:]
             dY[n:] = -tangent @ Y[:n] - Cm @ Y[n:]
             dY[n:, 2 * n] -= eps * scale * t * math.sin(phase) * Pm
-            dY[n:, 2 * n + 1] += eps * math.cos(phase) * Pm
+            if epsilon_column:
+                dY[n:, 2 * n + 1] += scale * math.cos(phase) * Pm - nonlinear(x)
+            else:
+                dY[n:, 2 * n + 1] += eps * math.cos(phase) * Pm
             return np.concatenate((v, a, dY.reshape(-1)))
 
         return system
@@ -444,31 +466,41 @@ class SmoothForcedFlow:
         return S
 
     # ------------------------------------------------------------------ integration
-    def _integrate(self, state0: Any, frequency: float, periods: int, forcing_scale: float, sensitivity: bool,
-                   times: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None, dict[str, int], Any]:
-        from scipy.integrate import solve_ivp  # here, not at module level: import lindstedt stays light
-
-        n2 = self.dimension
+    def _state(self, state0: Any) -> np.ndarray:
         z = np.array(state0, dtype=float).reshape(-1)
-        if z.shape != (n2,) or not np.all(np.isfinite(z)):
-            raise ProblemError(f"state0 must be {n2} finite numbers (X, X'), got {state0!r}")
+        if z.shape != (self.dimension,) or not np.all(np.isfinite(z)):
+            raise ProblemError(f"state0 must be {self.dimension} finite numbers (X, X'), got {state0!r}")
+        return z
+
+    def _forcing(self, frequency: float, periods: int, forcing_scale: float) -> tuple[float, float, float]:
+        """(Ω, s, kT) of a period map, checked."""
         frequency = check_forcing_frequency(frequency, "frequency")
         if isinstance(periods, bool) or not isinstance(periods, (int, np.integer)) or periods < 1:
             raise ProblemError(f"periods must be a positive integer, got {periods!r}")
         scale = float(forcing_scale)
         if not math.isfinite(scale):
             raise ProblemError(f"forcing_scale must be finite, got {forcing_scale!r}")
-        end = 2.0 * math.pi * int(periods) / frequency
+        return frequency, scale, 2.0 * math.pi * int(periods) / frequency
+
+    def _integrate(self, z: np.ndarray, end: float, frequency: float, scale: float, sensitivity: bool,
+                   times: np.ndarray | None = None, epsilon_column: bool = False
+                   ) -> tuple[np.ndarray, np.ndarray | None, dict[str, int], Any]:
+        """z(end) from z(0) = z (checked), its sensitivity block Y(end), the counters and (the final region, the
+        samples at ``times`` in [0, end), the elements whose breakpoints were crossed)."""
+        from scipy.integrate import solve_ivp  # here, not at module level: import lindstedt stays light
+
+        n2 = self.dimension
         Y = np.hstack([np.eye(n2), np.zeros((n2, 2))]) if sensitivity else None
         region = self._region(z)
         t, counters = 0.0, {"steps": 0, "evaluations": 0, "arcs": 0, "switches": 0}
         stalled = 0
         samples: list[np.ndarray] = []
+        crossed: set[int] = set()
         atol = self._absolute_tolerances(z, frequency, scale, sensitivity)
-        natural = int(periods) * max(1.0, self._frequencies[1] / frequency)
+        natural = max(1.0, end * self._frequencies[1] / (2.0 * math.pi), end * frequency / (2.0 * math.pi))
         evaluations = _Metered(int(_MAX_EVALUATIONS_PER_NATURAL_PERIOD * natural))
         while True:
-            rhs = evaluations.wrap(self._fields(region, frequency, scale, sensitivity))
+            rhs = evaluations.wrap(self._fields(region, frequency, scale, sensitivity, epsilon_column))
             events = self._events(region)
             y0 = np.concatenate((z, Y.reshape(-1))) if sensitivity else z
             window = None if times is None else times[(times >= t) & (times < end)]
@@ -505,6 +537,7 @@ class SmoothForcedFlow:
             Y = y[n2:].reshape(n2, n2 + 2).copy() if sensitivity else None
             old, region = region, events[k][1]
             counters["switches"] += 1
+            crossed.update(i for i, (a, b) in enumerate(zip(old, region)) if a != b)
             if self._scalar:
                 z[0] = self._elements.laws[0].breakpoints[min(old[0], region[0])]  # exactly on the breakpoint
             if sensitivity:
@@ -513,12 +546,8 @@ class SmoothForcedFlow:
                     Y = S @ Y
         self.steps += counters["steps"]
         self.evaluations += counters["evaluations"]
-        if sensitivity:
-            final_field = self._fields(region, frequency, scale, False)(end, z)
-            Y = Y.copy()
-            Y[:, n2] += final_field * (-end / frequency)
         sampled = np.vstack(samples) if samples else np.empty((0, n2))
-        return z, Y, counters, (region, sampled)
+        return z, Y, counters, (region, sampled, tuple(sorted(crossed)))
 
     def period_map(self, state0: Any, frequency: float, *, periods: int = 1, forcing_scale: float = 1.0,
                    sensitivity: bool = True) -> PeriodMapValue:
@@ -532,11 +561,13 @@ class SmoothForcedFlow:
         >>> sorted(value.counters), value.counters["switches"]
         (['arcs', 'evaluations', 'steps', 'switches'], 0)
         """
-        z, Y, counters, _ = self._integrate(state0, frequency, periods, forcing_scale, sensitivity)
+        frequency, scale, end = self._forcing(frequency, periods, forcing_scale)
+        z, Y, counters, (region, _, _) = self._integrate(self._state(state0), end, frequency, scale, sensitivity)
         if not sensitivity:
             return PeriodMapValue(z, counters=counters)
         n2 = self.dimension
-        return PeriodMapValue(z, Y[:, :n2].copy(), Y[:, n2].copy(), Y[:, n2 + 1].copy(), counters)
+        moving_end = self._fields(region, frequency, scale, False)(end, z) * (-end / frequency)  # kT = 2πk/Ω
+        return PeriodMapValue(z, Y[:, :n2].copy(), Y[:, n2] + moving_end, Y[:, n2 + 1].copy(), counters)
 
     def sample(self, state0: Any, frequency: float, *, periods: int = 1, forcing_scale: float = 1.0,
                samples: int = 256) -> tuple[np.ndarray, np.ndarray]:
@@ -552,10 +583,138 @@ class SmoothForcedFlow:
         """
         if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
             raise ProblemError(f"samples must be a positive integer, got {samples!r}")
-        frequency = check_forcing_frequency(frequency, "frequency")
-        times = np.arange(int(samples)) * (2.0 * math.pi * int(periods) / frequency / int(samples))
-        _, _, _, (_, sampled) = self._integrate(state0, frequency, periods, forcing_scale, False, times)
+        frequency, scale, end = self._forcing(frequency, periods, forcing_scale)
+        times = np.arange(int(samples)) * (end / int(samples))
+        _, _, _, (_, sampled, _) = self._integrate(self._state(state0), end, frequency, scale, False, times)
         return times, sampled
+
+    def run(self, state0: Any, t: float, times: Any) -> tuple[PeriodMapValue, np.ndarray, tuple[int, ...]]:
+        """:meth:`advance` with ``∂z(t)/∂z0`` and, in the same integration, the states at ``times`` (ascending, in
+        ``[0, t)``; shape (len(times), 2N)) and the elements whose breakpoints the motion crossed: what the
+        verification of a periodic orbit reads from one run over its period.
+
+        Examples
+        --------
+        >>> from lindstedt import UnilateralSystem
+        >>> flow = SmoothForcedFlow(UnilateralSystem(M=[[1]], K=[[1]], A=[[1]], laws=["Max(0, u)"]), 3.0)
+        >>> value, states, crossed = flow.run([1.0, 0.0], 3 * np.pi / 2, [0.0, np.pi / 4])   # the bilinear orbit
+        >>> bool(np.allclose(value.state, [1.0, 0.0], atol=1e-10)), states.shape, crossed
+        (True, (2, 2), (0,))
+        """
+        if not isinstance(self.problem, UnilateralSystem):
+            raise ProblemError("run is the free flow of a UnilateralSystem; a forced problem has period_map")
+        end = real_argument(t, "t")
+        grid = np.asarray(times, dtype=float).reshape(-1)
+        if not (end >= 0 and np.all(np.diff(grid) > 0) and np.all((grid >= 0) & (grid < end))):
+            raise ProblemError(f"run needs t ≥ 0 and ascending times in [0, t), got t = {t!r}, times = {times!r}")
+        z, Y, counters, (_, sampled, crossed) = self._integrate(self._state(state0), end, self._frequencies[0], 0.0,
+                                                                True, grid, epsilon_column=True)
+        return PeriodMapValue(z, Y[:, :self.dimension].copy(), counters=counters), sampled, crossed
+
+    def steepest_slopes(self, lower: Any, upper: Any) -> np.ndarray:
+        """``max |f_i'(u)|`` of every element's law over ``u ∈ [lower_i, upper_i]`` (the analytic pieces' slopes on
+        a 129-point grid and at both sides of every breakpoint inside): the local stiffness of a motion whose
+        element deformations stay in those ranges.  A law that jumps in its range has none: ``inf``.
+
+        Examples
+        --------
+        >>> from lindstedt import UnilateralSystem
+        >>> flow = SmoothForcedFlow(UnilateralSystem(M=[[1]], K=[[1]], A=[[1]], laws=["u**3"]), 1.0)
+        >>> flow.steepest_slopes([-1.0], [2.0]).tolist()       # 3 u² at u = 2
+        [12.0]
+        """
+        out = []
+        for law, low, high in zip(self._elements.laws, np.atleast_1d(lower), np.atleast_1d(upper)):
+            low, high = float(low), float(high)
+            inside = [p for p in law.breakpoints if low <= p <= high]
+            if any(law.jumps_at(k) for k, p in enumerate(law.breakpoints) if low <= p <= high):
+                out.append(math.inf)
+                continue
+            width = max(high - low, 0.0)
+            points = np.unique(np.r_[np.linspace(low, high, 129), [p - 1e-9 * (1 + width) for p in inside],
+                                     [p + 1e-9 * (1 + width) for p in inside]])
+            steepest = 0.0
+            for u in points:
+                _, slope, _ = law.pieces[law.region(float(u), 0.0)]
+                steepest = max(steepest, abs(slope(float(u))))
+            out.append(steepest)
+        return np.array(out)
+
+    def static_equilibrium(self) -> np.ndarray:
+        """The rest state ``X*`` of the free system, ``K X* + ε Σ_i w_i f_i(a_iᵀ X* − b_i) = 0``, nearest to X = 0.
+
+        X = 0 when every element's force vanishes there; else the core's damped Newton from X = 0 on the elements'
+        analytic pieces, to rounding (a :class:`ConvergenceError` where it finds none — e.g. a jump of a law at the
+        equilibrium).
+
+        Examples
+        --------
+        A prestressed cubic spring, ``x + ε (x − 1)³ = 0`` at ε = 1: ``x*`` is the real root of ``x³ − 3x² + 4x − 1``:
+
+        >>> from lindstedt import UnilateralSystem
+        >>> flow = SmoothForcedFlow(UnilateralSystem(M=[[1]], K=[[1]], A=[[1]], b=[1], laws=["u**3"]), 1.0)
+        >>> x = float(flow.static_equilibrium()[0])
+        >>> abs(x**3 - 3 * x**2 + 4 * x - 1) < 1e-15
+        True
+        """
+        from .newton import Evaluation, newton  # the core Newton (numerics.newton imports nothing of this module)
+
+        n, eps, elements = self.n_dof, self.epsilon, self._elements
+        zero = np.zeros(n)
+
+        def pieces(x: np.ndarray) -> list[tuple[Callable, Callable, float]]:
+            return [law.pieces[r] for law, r in zip(elements.laws, elements.region(x, zero))]
+
+        def forces(x: np.ndarray) -> np.ndarray:
+            return np.array([value(u) for (value, _, _), u in zip(pieces(x), elements.A @ x - elements.b)])
+
+        if eps == 0.0 or not np.any(forces(zero)):
+            return zero
+        size = max(1.0, float(np.max(np.abs(elements.b))))
+        row_scale = float(np.linalg.norm(self._Km, 2)) * size
+
+        def evaluate(x: np.ndarray) -> Evaluation:
+            u = elements.A @ x - elements.b
+            chosen = pieces(x)
+            residual = self._Km @ x + eps * (elements.MW @ np.array([value(ui) for (value, _, _), ui in zip(chosen, u)]))
+            slopes = np.array([slope(ui) for (_, slope, _), ui in zip(chosen, u)])
+            jacobian = self._Km + eps * (elements.MW * slopes) @ elements.A
+            return Evaluation(True, "", residual / row_scale, jacobian / row_scale,
+                              singular="a singular tangent stiffness K + ε Σ w_i f_i' a_iᵀ at the iterate")
+
+        outcome = newton(evaluate, zero, np.full(n, size), tol=1e-14, max_iterations=60, step_tol=1e-15)
+        if not outcome.success:
+            raise ConvergenceError(f"no static equilibrium near X = 0 at ε = {eps:g}: {outcome.message}")
+        return outcome.unknowns
+
+    def advance(self, state0: Any, t: float, *, sensitivity: bool = True, d_epsilon: bool = False) -> PeriodMapValue:
+        """The free flow ``z(t)`` of a :class:`~lindstedt.UnilateralSystem` (no load, no damping) from ``z(0) = z0``:
+        ``∂z(t)/∂z0`` with ``sensitivity``, ``∂z(t)/∂ε`` with ``d_epsilon`` (the variational equation forced by
+        ``−M⁻¹ Σ_i w_i f_i(a_iᵀ X − b_i)``, through the saltation matrices where a law jumps).
+
+        The autonomous form of :meth:`period_map`, as :meth:`lindstedt.numerics.ExactFlow.advance`: the shooting
+        of NNMs of systems with any law flows through it.
+
+        Examples
+        --------
+        ``u'' + u + ε u³ = 0`` at ε = 0 from (1, 0): ``u = cos t``, and ``∂u/∂ε = (cos 3t − cos t)/32 − (3/8) t sin t``:
+
+        >>> from lindstedt import UnilateralSystem
+        >>> flow = SmoothForcedFlow(UnilateralSystem(M=[[1]], K=[[1]], A=[[1]], laws=["u**3"]), 0.0)
+        >>> value = flow.advance([1.0, 0.0], np.pi / 2, d_epsilon=True)
+        >>> round(float(value.state[0]), 12) + 0.0, round(float(value.d_epsilon[0]), 10) == round(-3 * np.pi / 16, 10)
+        (0.0, True)
+        """
+        if not isinstance(self.problem, UnilateralSystem):
+            raise ProblemError("advance is the free flow of a UnilateralSystem; a forced problem has period_map")
+        end = real_argument(t, "t")
+        if not end >= 0:
+            raise ProblemError(f"t must be a non-negative time, got {t!r}")
+        z, Y, counters, _ = self._integrate(self._state(state0), end, self._frequencies[0], 0.0,
+                                            bool(sensitivity or d_epsilon), epsilon_column=True)
+        n2 = self.dimension
+        return PeriodMapValue(z, Y[:, :n2].copy() if sensitivity else None, counters=counters,
+                              d_epsilon=Y[:, n2 + 1].copy() if d_epsilon else None)
 
 
 def _event(function: Callable[[float, np.ndarray], float], direction: int) -> Callable[[float, np.ndarray], float]:

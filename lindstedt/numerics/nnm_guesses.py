@@ -18,7 +18,7 @@ import numpy as np
 from .._errors import ProblemError
 from .._precision import LOCK
 from .results import NNMResult
-from .shooting import _TWO_PI, NNMShooting, _Amplitude, _equilibrium, nnm_energy
+from .shooting import _TWO_PI, NNMShooting, _Amplitude, nnm_energy
 
 
 class _ExpansionPredictor:
@@ -84,7 +84,7 @@ class _ExpansionPredictor:
             return None
         x0 = np.asarray(self.expansion.release_state(float(epsilon)), dtype=float)
         if self.amplitude.kind != "modal_amplitude":  # scale about the equilibrium to the target energy
-            equilibrium = _equilibrium(problem.system, epsilon)
+            equilibrium = problem.equilibrium(epsilon)
             floor = nnm_energy(problem.system, equilibrium, np.zeros(problem.n), epsilon)
             level = nnm_energy(problem.system, x0, np.zeros(problem.n), epsilon) - floor
             excess = self.amplitude.target(epsilon) - floor
@@ -97,12 +97,12 @@ class _ExpansionPredictor:
 
 def _impossible_amplitude(problem: NNMShooting, epsilon: float, amplitude: _Amplitude) -> str | None:
     if amplitude.kind == "modal_amplitude":
-        equilibrium = _equilibrium(problem.system, epsilon)
+        equilibrium = problem.equilibrium(epsilon)
         if amplitude.value == float(problem.modal_row @ equilibrium):
             return (f"impossible amplitude: u_j(0) = {amplitude.value:g} is the equilibrium's, so the orbit is the "
                     "rest state; give a non-zero modal amplitude")
         return None
-    floor = nnm_energy(problem.system, _equilibrium(problem.system, epsilon), np.zeros(problem.n), epsilon)
+    floor = nnm_energy(problem.system, problem.equilibrium(epsilon), np.zeros(problem.n), epsilon)
     target = amplitude.target(epsilon)
     if not target > floor:
         return (f"impossible energy: the target E = {target:.6g} is not above the minimum {floor:.6g} (the static "

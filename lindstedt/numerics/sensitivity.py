@@ -45,9 +45,10 @@ def _check_epsilon(epsilon: Any) -> float:
     return parse_float(epsilon, what="epsilon")
 
 
-def _map_over(flow: ExactFlow, x0: np.ndarray, v0: np.ndarray, t: float, *, sensitivity: bool,
+def _map_over(flow: Any, x0: np.ndarray, v0: np.ndarray, t: float, *, sensitivity: bool,
               d_epsilon: bool) -> PeriodMapValue | str:
-    """The state after time t (:meth:`ExactFlow.advance`, the autonomous period map), or the failure's words."""
+    """The state after time t of a free flow (``advance`` of :class:`ExactFlow` or of
+    :class:`~lindstedt.numerics.SmoothForcedFlow`, the autonomous period map), or the failure's words."""
     try:
         return flow.advance(np.r_[x0, v0], t, sensitivity=sensitivity, d_epsilon=d_epsilon)
     except ConvergenceError as error:

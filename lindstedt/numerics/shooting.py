@@ -1,15 +1,19 @@
-"""NNM shooting for  M X'' + K X + ε W (A X − b)_+ = 0 : the residual, its exact Jacobian, Newton, one orbit.
+"""NNM shooting for  M X'' + K X + ε Σ_i w_i f_i(a_iᵀ X − b_i) = 0 : the residual, its exact Jacobian, Newton, one orbit.
 
 A nonlinear normal mode (NNM, in Rosenberg's sense) of mode j is a periodic
 orbit that grows out of the linear mode ``φ_j`` (``K φ_j = λ_j² M φ_j``,
 ``Φᵀ M Φ = I``) as ε → 0 or as the amplitude → 0.  It is computed here by
-*shooting*: unknown initial state and period, residuals evaluated with the
-exact piecewise closed-form flow (:class:`lindstedt.numerics.ExactFlow`), and a
-Newton (Gauss–Newton) iteration whose Jacobian is exact — the state transition
-matrix of the flow over T/2 or T (over a full period: the monodromy matrix),
-the vector field at the end point for the derivative in T, and a closed-form
-Duhamel integral for the derivative in ε (:mod:`lindstedt.numerics.sensitivity`).
-No finite differences are used.
+*shooting*: unknown initial state and period, residuals evaluated with a flow,
+and a Newton (Gauss–Newton) iteration whose Jacobian is exact — the state
+transition matrix of the flow over T/2 or T (over a full period: the monodromy
+matrix), the vector field at the end point for the derivative in T, and the
+derivative in ε.  No finite differences are used.  Where every element is a
+unilateral spring ``f_i = (·)_+`` the flow is the exact piecewise closed form
+(:class:`lindstedt.numerics.ExactFlow`, its ∂/∂ε a closed-form Duhamel integral,
+:mod:`lindstedt.numerics.sensitivity`); for any other law (``u**3``, a Hertz
+contact ``Max(0, u)**(3/2)``, a gap with a jump …) it is DOP853 with its
+variational equations, stopped at every breakpoint of every law (the saltation
+matrices where a law jumps; :class:`lindstedt.numerics.SmoothForcedFlow`).
 
 Formulations (``formulation=``)
 -------------------------------
@@ -84,12 +88,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
-from .._errors import ConvergenceError, ProblemError
+from .._errors import ConvergenceError, ProblemError, UnsupportedNonlinearityError
 from .flow import ExactFlow
+from .forced_smooth import SmoothForcedFlow
 from .newton import Evaluation, newton
 from ..problems.parsing import parse_float
 from ..problems.system import UnilateralSystem
@@ -110,7 +115,8 @@ _STEP_TOL = 1e-7
 def nnm_energy(system: UnilateralSystem, x: Any, v: Any, epsilon: float) -> float:
     """The energy used to parametrise NNMs.
 
-    ``W = Aᵀ``: the conserved energy ``½ X'ᵀ M X' + ½ Xᵀ K X + ½ ε Σ (A X − b)_+²``.
+    ``W = Aᵀ``: the conserved energy ``½ X'ᵀ M X' + ½ Xᵀ K X + ε Σ_i V_i(a_iᵀ X − b_i)``, ``V_i = ∫_0^u f_i``
+    (``½ (·)_+²`` for a unilateral spring; :meth:`UnilateralSystem.energy`).
     ``W ≠ Aᵀ`` (no conserved energy exists): the linear energy
     ``½ X'ᵀ M X' + ½ Xᵀ K X`` of the given state — for an NNM, of its release
     point.
@@ -127,7 +133,7 @@ def nnm_energy(system: UnilateralSystem, x: Any, v: Any, epsilon: float) -> floa
     v = np.asarray(v, dtype=float)
     value = 0.5 * float(v @ system.M @ v) + 0.5 * float(x @ system.K @ x)
     if system.symmetric_coupling and system.n_springs:
-        value += 0.5 * float(epsilon) * float(np.sum(np.maximum(system.gaps(x), 0.0) ** 2))
+        value += float(epsilon) * float(np.sum(system._element_potentials(system.gaps(x))))
     return value
 
 
@@ -138,13 +144,13 @@ def _energy_gradient(
     grad_x = system.K @ x
     d_eps = 0.0
     if system.symmetric_coupling and system.n_springs:
-        engaged = np.maximum(system.gaps(x), 0.0)
-        grad_x = grad_x + epsilon * system.A.T @ engaged
-        d_eps = 0.5 * float(np.sum(engaged**2))
+        gaps = system.gaps(x)
+        grad_x = grad_x + epsilon * system.A.T @ system._element_forces(gaps)
+        d_eps = float(np.sum(system._element_potentials(gaps)))
     return grad_x, system.M @ v, d_eps
 
 
-def _equilibrium(system: UnilateralSystem, epsilon: float) -> np.ndarray:
+def _unilateral_equilibrium(system: UnilateralSystem, epsilon: float) -> np.ndarray:
     """Static equilibrium ``K X + ε W (A X − b)_+ = 0`` by active-set iteration (X = 0 when b ≥ 0)."""
     n = system.n_dof
     if system.n_springs == 0 or np.all(system.b >= 0):
@@ -207,6 +213,26 @@ def _state_at(run: dict[str, Any], t: float) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(x, dtype=float), np.asarray(v, dtype=float)
 
 
+@dataclass(frozen=True)
+class _Run:
+    """One flow over a candidate period, as the verification reads it: the end state, the monodromy, the switch
+    count and the elements switching, the state at any time of the period and (any law) the steepest slope of
+    every element's law over the deformations met (None for unilateral springs: Yorke's bound is global)."""
+
+    state: np.ndarray
+    monodromy: np.ndarray
+    switches: int
+    elements: tuple[int, ...]
+    state_at: Callable[[float], tuple[np.ndarray, np.ndarray]]
+    slopes: np.ndarray | None = None
+
+
+#: the verification samples an orbit of any law at this many equally spaced times (the range of its elements'
+#: deformations, for Yorke's bound) and at T/m for m up to _PROBED_REPETITIONS (the minimal-period test)
+_SAMPLES = 64
+_PROBED_REPETITIONS = 16
+
+
 # --------------------------------------------------------------------------- #
 # the shooting problem
 # --------------------------------------------------------------------------- #
@@ -255,7 +281,6 @@ class NNMShooting:
     ) -> None:
         if not isinstance(system, UnilateralSystem):
             raise ProblemError(f"system must be a UnilateralSystem, got {type(system).__name__}")
-        system.require_unilateral("NNM shooting (nnm_point, continue_nnm, nnm_sweep)")
         if formulation not in _FORMULATIONS:
             raise ProblemError(f"formulation must be one of {_FORMULATIONS}, got {formulation!r}")
         if release_sign not in (1, -1):
@@ -272,7 +297,7 @@ class NNMShooting:
         self.modal_row = system.M @ self.shape  # u_j = (M φ_j)ᵀ X
         self.projector = shapes.T @ system.M  # u = Φᵀ M X
         self.n_unknowns = self.n + 1 if formulation == "symmetric" else 2 * self.n + 1
-        self._flows: dict[float, ExactFlow] = {}
+        self._flows: dict[float, ExactFlow | SmoothForcedFlow] = {}
         self._expansions: dict[tuple[str, float], Any] = {}  # lindstedt.nnm per (amplitude kind, a0)
         self.flow_evaluations = 0
         self.set_scales(epsilon=0.0)
@@ -287,7 +312,7 @@ class NNMShooting:
     def _guess_amplitude(self, epsilon: float, amplitude: _Amplitude | None = None) -> tuple[np.ndarray, float]:
         """Release position of the linear-mode guess and its modal amplitude."""
         amplitude = amplitude or self.amplitude
-        equilibrium = _equilibrium(self.system, epsilon)
+        equilibrium = self.equilibrium(epsilon)
         if amplitude.kind == "modal_amplitude":
             offset = amplitude.value - float(self.modal_row @ equilibrium)
             return equilibrium + offset * self.shape, offset
@@ -321,13 +346,22 @@ class NNMShooting:
         return np.r_[np.full(self.n, self.position_scale), np.full(self.n, self.velocity_scale), self.period_scale]
 
     # ------------------------------------------------------------------ pieces
-    def _flow(self, epsilon: float) -> ExactFlow:
+    def _flow(self, epsilon: float) -> ExactFlow | SmoothForcedFlow:
+        """The flow at ε: exact for unilateral springs, DOP853 with variational equations for any other law."""
         flow = self._flows.get(epsilon)
         if flow is None:
             if len(self._flows) > 8:
                 self._flows.clear()
-            flow = self._flows[epsilon] = ExactFlow(self.system, epsilon)
+            kind = ExactFlow if self.system.unilateral else SmoothForcedFlow
+            flow = self._flows[epsilon] = kind(self.system, epsilon)
         return flow
+
+    def equilibrium(self, epsilon: float) -> np.ndarray:
+        """The static equilibrium about which the NNMs oscillate: active sets for unilateral springs, the core
+        Newton from X = 0 on the elements' laws otherwise (:meth:`SmoothForcedFlow.static_equilibrium`)."""
+        if self.system.unilateral:
+            return _unilateral_equilibrium(self.system, epsilon)
+        return self._flow(epsilon).static_equilibrium()
 
     def initial_guess(self, epsilon: float) -> np.ndarray:
         """Unknowns of the linear mode j with the requested amplitude (period 2π/λ_j)."""
@@ -460,13 +494,18 @@ class NNMShooting:
             return 1.0, self.mode
         return float(modal_energy[self.mode - 1] / total), int(np.argmax(modal_energy)) + 1
 
-    def shortest_period(self, epsilon: float) -> float:
+    def shortest_period(self, epsilon: float, slopes: Any = None) -> float:
         """A lower bound ``2π / L`` of the period of every non-constant periodic orbit at ε (Yorke, 1969).
 
-        ``L`` bounds the Lipschitz constant of the vector field ``(X, X') ↦ (X', −M⁻¹(K X + ε W (A X − b)_+))``
-        in the norm ``|(√κ X, X')|``: every contact state's stiffness obeys
-        ``‖M⁻¹ K_S‖ ≤ κ = ‖M⁻¹ K‖ + |ε| Σ_i ‖M⁻¹ w_i‖ ‖a_i‖``, so ``L ≤ √κ``.  A shooting solution with a shorter
+        ``L`` bounds the Lipschitz constant of the vector field ``(X, X') ↦ (X', −M⁻¹(K X + ε Σ_i w_i f_i(u_i)))``
+        in the norm ``|(√κ X, X')|``: where every law's slope obeys ``|f_i'| ≤ s_i`` the tangent stiffness obeys
+        ``‖M⁻¹ K_T‖ ≤ κ = ‖M⁻¹ K‖ + |ε| Σ_i s_i ‖M⁻¹ w_i‖ ‖a_i‖``, so ``L ≤ √κ``.  A shooting solution with a shorter
         period is a collapse of the iteration (T → 0 solves the half-period equations), never an orbit.
+
+        ``slopes`` are the ``s_i``: 1 for unilateral springs (the default, a global bound); for other laws the
+        steepest slope over the deformations an orbit reaches (:meth:`SmoothForcedFlow.steepest_slopes`), a bound
+        for the periodic orbits in that range (Yorke's proof uses the field at the orbit's points only).  A law that
+        jumps (slope ``inf``) has no Lipschitz constant: the bound is 0.
 
         Examples
         --------
@@ -476,9 +515,11 @@ class NNMShooting:
         """
         system = self.system
         stiffness = float(np.linalg.norm(np.linalg.solve(system.M, system.K), 2))
-        if system.n_springs:
+        if system.n_springs and epsilon != 0:
+            steepest = np.ones(system.n_springs) if slopes is None else np.abs(np.asarray(slopes, dtype=float))
             loads = np.linalg.solve(system.M, system.W)
-            stiffness += abs(epsilon) * float(np.sum(np.linalg.norm(loads, axis=0) * np.linalg.norm(system.A, axis=1)))
+            stiffness += abs(epsilon) * float(np.sum(steepest * np.linalg.norm(loads, axis=0)
+                                                     * np.linalg.norm(system.A, axis=1)))
         return _TWO_PI / math.sqrt(stiffness)
 
     def floquet(self, monodromy: np.ndarray, flow_vector: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -546,38 +587,35 @@ class NNMShooting:
         x0, v0, period = self.split(unknowns)
         if not (math.isfinite(period) and period > 0):
             return self._failure(epsilon, f"invalid period T = {period}", iterations, label=label, x0=x0)
-        shortest = self.shortest_period(epsilon)
+        shortest = self.shortest_period(epsilon) if self.system.unilateral else 0.0
         if period < shortest:
-            return self._failure(epsilon, (
-                f"degenerate solution: the period T = {period:.3g} collapsed below {shortest:.6g}, the shortest period "
-                f"of any periodic orbit at ε = {epsilon:g} (2π/L, L the Lipschitz constant of the flow: Yorke's "
-                f"bound){note}"), iterations, label=label, x0=x0)
+            return self._collapse(epsilon, period, shortest, note, iterations, label, x0)
         self.flow_evaluations += 1
-        flow = self._flow(epsilon)
         try:
-            run = flow._run(x0, v0, period, dense=True, sensitivity=True)
-        except ProblemError as error:
+            run = self._closed_run(epsilon, x0, v0, period)
+        except (ProblemError, ConvergenceError) as error:
             return self._failure(epsilon, f"the flow failed: {error}", iterations, label=label, x0=x0)
-        if not run["success"]:
-            return self._failure(epsilon, f"the flow failed: {run['message']}", iterations, label=label, x0=x0)
+        if run.slopes is not None:  # any law: Yorke's bound from the slopes over the deformations of this run
+            shortest = self.shortest_period(epsilon, run.slopes)
+            if period < shortest:
+                return self._collapse(epsilon, period, shortest, note, iterations, label, x0)
         frequency = _TWO_PI / period
-        equilibrium = _equilibrium(self.system, epsilon)
+        equilibrium = self.equilibrium(epsilon)
         scale = max(float(np.max(np.abs(x0))), float(np.max(np.abs(v0))) / frequency, np.finfo(float).tiny)
 
         def distance(x: np.ndarray, v: np.ndarray) -> float:
             return max(float(np.max(np.abs(x - x0))), float(np.max(np.abs(v - v0))) / frequency) / scale
 
-        residual = distance(run["x"], run["v"])
-        switches = len(run["events"])
-        springs = tuple(sorted({event.spring for event in run["events"]}))
+        residual = distance(run.state[:self.n], run.state[self.n:])
+        switches, springs = run.switches, run.elements
         # the orbit is run m times in T only if m divides its switch count (and T/m is a possible period)
-        longest = int(period // shortest)
+        longest = int(period // shortest) if shortest > 0 else _PROBED_REPETITIONS  # 0: a law jumps, no bound
         candidates = [m for m in range(2, longest + 1) if switches % m == 0]
-        repetitions = _repetitions(candidates, lambda m: distance(*_state_at(run, period / m)), residual)
+        repetitions = _repetitions(candidates, lambda m: distance(*run.state_at(period / m)), residual)
         amp_value, _, _, _ = self._amplitude_row(x0, v0, epsilon, amplitude)
         amp_scale = max(abs(amplitude.target(epsilon)), self.amplitude_scale, np.finfo(float).tiny)
         amplitude_error = abs(amp_value) / amp_scale
-        monodromy = run["jacobian"]
+        monodromy = run.monodromy
         flow_vector = np.r_[v0, self.system.acceleration(x0, epsilon)]
         trivial, nontrivial = self.floquet(monodromy, flow_vector)
         multipliers = np.r_[trivial, nontrivial]
@@ -613,16 +651,59 @@ class NNMShooting:
         return NNMResult(
             success=success, message=message, mode=self.mode, epsilon=epsilon, frequency=frequency, period=period,
             linear_frequency=self.linear_frequency, release_position=np.array(x0), release_velocity=np.array(v0),
-            modal_coordinates=self.projector @ x0, energy=nnm_energy(self.system, x0, v0, epsilon),
+            modal_coordinates=self.projector @ x0, energy=self._energy_or_nan(x0, v0, epsilon),
             floquet_multipliers=multipliers, stable=stable, residual=residual, n_switches=switches,
             mode_share=share, formulation=label, newton_iterations=iterations,
             flow_evaluations=self.flow_evaluations, monodromy=monodromy, system=self.system,
             contact_springs=springs, minimal_periods=repetitions,
         )
 
+    def _energy_or_nan(self, x0: np.ndarray, v0: np.ndarray, epsilon: float) -> float:
+        """:func:`nnm_energy` of the release state, NaN where a law's potential has no closed form."""
+        try:
+            return nnm_energy(self.system, x0, v0, epsilon)
+        except UnsupportedNonlinearityError:
+            return math.nan
+
+    def _closed_run(self, epsilon: float, x0: np.ndarray, v0: np.ndarray, period: float) -> _Run:
+        """The flow over the period from (x0, v0) with its monodromy, dense (raises ConvergenceError if it fails)."""
+        flow = self._flow(epsilon)
+        n = self.n
+        if isinstance(flow, ExactFlow):
+            run = flow._run(x0, v0, period, dense=True, sensitivity=True)
+            if not run["success"]:
+                raise ConvergenceError(run["message"])
+            return _Run(np.r_[run["x"], run["v"]], run["jacobian"], len(run["events"]),
+                        tuple(sorted({event.spring for event in run["events"]})), lambda t: _state_at(run, t))
+        fractions = {period * k / _SAMPLES for k in range(_SAMPLES)} | \
+            {period / m for m in range(2, _PROBED_REPETITIONS + 1)}
+        times = np.array(sorted(fractions))
+        value, states, crossed = flow.run(np.r_[x0, v0], period, times)
+        probes = {float(t): state for t, state in zip(times, states)}
+
+        def state_at(t: float) -> tuple[np.ndarray, np.ndarray]:
+            state = probes.get(float(t))
+            if state is None:
+                self.flow_evaluations += 1
+                state = flow.advance(np.r_[x0, v0], t, sensitivity=False).state
+            return state[:n], state[n:]
+
+        gaps = self.system.gaps(states[:, :n])
+        slopes = flow.steepest_slopes(np.min(gaps, axis=0), np.max(gaps, axis=0))
+        return _Run(value.state, value.d_state, value.counters["switches"], crossed, state_at, slopes)
+
+    def _collapse(self, epsilon: float, period: float, shortest: float, note: str, iterations: int,
+                  label: str, x0: np.ndarray) -> NNMResult:
+        return self._failure(epsilon, (
+            f"degenerate solution: the period T = {period:.3g} collapsed below {shortest:.6g}, the shortest period "
+            f"of any periodic orbit at ε = {epsilon:g} (2π/L, L the Lipschitz constant of the flow: Yorke's "
+            f"bound){note}"), iterations, label=label, x0=x0)
+
     def _contact_words(self, x0: np.ndarray, switches: int, epsilon: float) -> str:
         """What the message says of an orbit without switches: free of every spring (the linear mode, ω = λ_j) or
         engaged on some springs all along (a linear mode of the stiffened system) — read from the release state."""
+        if not self.system.unilateral:
+            return ""  # other laws act without contact too (a cubic spring): no claim on the orbit's linearity
         if switches or not self.system.n_springs:
             return "" if switches else "; no contact along the orbit: it is the linear mode (ω = λ_j)"
         engaged = tuple(int(i) for i in np.flatnonzero(self.system.gaps(x0) > 0))

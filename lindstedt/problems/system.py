@@ -96,8 +96,8 @@ class UnilateralSystem:
     A : array_like, shape (m, N)
         One row per unilateral spring; ``g_i = A_i X − b_i`` is its gap
         function.  ``A = []`` (with ``b = []``) means no unilateral spring.
-    b : array_like, shape (m,)
-        Gaps (any sign; ``b_i < 0`` is a preloaded spring).
+    b : array_like, shape (m,), optional
+        Gaps (any sign; ``b_i < 0`` is a preloaded spring); default zeros.
     W : array_like, shape (N, m), optional
         Distribution of the spring forces on the masses; default ``Aᵀ``
         (the conservative case, with energy ``E`` of :meth:`energy`).
@@ -151,7 +151,8 @@ class UnilateralSystem:
     W_exact: sympy.ImmutableMatrix
     laws: tuple[sympy.Expr, ...]
 
-    def __init__(self, M: Any, K: Any, A: Any = (), b: Any = (), W: Any | None = None, laws: Any = None) -> None:
+    def __init__(self, M: Any, K: Any, A: Any = (), b: Any | None = None, W: Any | None = None,
+                 laws: Any = None) -> None:
         M_exact = _exact_matrix(M, "M", ndim=2)
         K_exact = _exact_matrix(K, "K", ndim=2)
         n = M_exact.rows
@@ -168,7 +169,7 @@ class UnilateralSystem:
                 "each row of A is one unilateral spring"
             )
         m = A_exact.rows
-        b_exact = _exact_matrix(b, "b", ndim=1)
+        b_exact = sympy.ImmutableMatrix.zeros(m, 1) if b is None else _exact_matrix(b, "b", ndim=1)
         if b_exact.rows != m:
             raise ProblemError(f"b must have one gap per row of A ({m}), got {b_exact.rows} entries")
         for i in range(m):
