@@ -173,3 +173,18 @@ def test_an_orbit_of_a_system_without_reduction_closes_under_an_independent_inte
     assert integrator_error < 1e-8
     assert np.max(np.abs(ends[0] - start)) <= 10 * integrator_error + 1e-11
     assert orbit.contact_springs == (1,)  # the Hertz contact opens and closes; the cubic spring has no breakpoint
+
+
+def test_the_cli_shoots_the_nnm_of_a_system_file_with_laws(tmp_path, capsys):
+    import json
+
+    from lindstedt.cli import main
+
+    path = tmp_path / "system.json"
+    path.write_text(json.dumps({"M": [[1, 0], [0, 1]], "K": [[2, -1], [-1, 2]], "A": [[1, 0], [0, 1], [1, -1]],
+                                "laws": ["u**3", "u**3", "u**3"]}))
+    code = main(["nnm", str(path), "--mode", "2", "--a0", "1", "--numeric", "--eps", "3/10", "--format", "json"])
+    assert code == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["success"]
+    assert result["frequency"] == pytest.approx(_duffing_frequency(3.0, 9 * 0.3, 1 / math.sqrt(2)), rel=RTOL)

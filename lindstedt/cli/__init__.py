@@ -13,7 +13,8 @@ Sub-commands
     Nonlinear normal mode of M X'' + K X + ε W (A X − b)_+ = 0 grown from mode J
     (``--eps E``: and the expansion's frequency at ε = E).
 ``lindstedt nnm SYSTEM.json --mode J --numeric (--a0 A | --energy E) --eps EPS [--format json]``
-    The same NNM by shooting on the exact flow: frequency, period, release state, Floquet multipliers.
+    The same NNM by shooting (the exact flow; DOP853 for laws other than unilateral springs): frequency, period,
+    release state, Floquet multipliers.
 ``lindstedt forced F --eps E (--from W1 --to W2 | --at W) [--omega0 W] [--zeta Z] [--forcing F] [--param NAME=VALUE ...]
 [--method exact|multiple-scales] [--order 1|2] [--format pretty|plain|latex|json] [--figure PATH]``
     Forced response of u'' + 2ζω0 u' + ω0² u + ε f(u) = ε F cos(Ω t): periodic responses by shooting on the
@@ -133,12 +134,14 @@ def build_parser() -> argparse.ArgumentParser:
     expand.add_argument("--waveforms", action="store_true", help="include the waveforms v_k in text/LaTeX output")
     expand.add_argument("--precision", type=int, default=30, help="decimal digits for non-polynomial f (default 30)")
 
-    nnm = commands.add_parser("nnm", help="nonlinear normal mode of M X'' + K X + eps W (A X - b)_+ = 0 by strained coordinates")
-    nnm.add_argument("system", help="SYSTEM.json with keys M, K, A, b and optional W and laws (nested lists, numbers "
-                                         "or exact strings; laws: one f(u) per row of A, default Max(0, u))")
+    nnm = commands.add_parser("nnm", help="nonlinear normal mode of M X'' + K X + eps W f(A X - b) = 0 by strained "
+                                          "coordinates (unilateral springs) or by shooting (--numeric, any law)")
+    nnm.add_argument("system", help="SYSTEM.json with keys M, K, A and optional b (default 0), W and laws (nested lists, "
+                                         "numbers or exact strings; laws: one f(u) per row of A, default Max(0, u))")
     nnm.add_argument("--mode", type=int, required=True, help="mode number j (1-based, increasing frequency)")
     nnm.add_argument("--a0", default=None, help="modal amplitude of mode j at release (expansion, or --numeric with the other modal coordinates free)")
-    nnm.add_argument("--numeric", action="store_true", help="periodic orbit by shooting on the exact flow instead of the expansion")
+    nnm.add_argument("--numeric", action="store_true", help="periodic orbit by shooting instead of the expansion (on the exact flow for "
+                     "unilateral springs, DOP853 with variational equations for other laws)")
     nnm.add_argument("--energy", default=None, help="with --numeric: prescribed energy instead of --a0")
     nnm.add_argument("--eps", default=None, metavar="E",
                      help="the value of epsilon: the expansion's frequency at E, or with --numeric the orbit at E (required there)")

@@ -440,7 +440,8 @@ def nnm_point(
     max_iterations: int = 30,
     min_mode_share: float | None = 0.5,
 ) -> NNMResult:
-    """The NNM of ``mode`` at one ε and one amplitude, by Newton shooting on the exact flow.
+    """The NNM of ``mode`` at one ε and one amplitude, by Newton shooting (the exact flow for unilateral springs,
+    DOP853 with variational equations for any other law).
 
     Parameters
     ----------

@@ -385,7 +385,7 @@ class UnilateralSystem:
 
     @classmethod
     def from_json_dict(cls, data: Mapping[str, Any]) -> "UnilateralSystem":
-        """Build from a mapping with keys ``M``, ``K``, ``A``, ``b`` and optional ``W`` and ``laws``.
+        """Build from a mapping with keys ``M``, ``K``, ``A`` and optional ``b`` (default zeros), ``W`` and ``laws``.
 
         Entries may be numbers or exact strings (as written by :meth:`to_json_dict`).
 
@@ -401,10 +401,11 @@ class UnilateralSystem:
         if unknown:
             raise ProblemError(f"unknown keys {unknown} in the system definition; the keys are M, K, A, b and optional W "
                                "and laws")
-        missing = [key for key in ("M", "K", "A", "b") if key not in data]
+        missing = [key for key in ("M", "K", "A") if key not in data]
         if missing:
-            raise ProblemError(f"the system definition lacks the keys {missing}; give M, K, A, b (A = [] and b = [] for none)")
-        return cls(M=data["M"], K=data["K"], A=data["A"], b=data["b"], W=data.get("W"), laws=data.get("laws"))
+            raise ProblemError(f"the system definition lacks the keys {missing}; give M, K, A and b (A = [] for none; "
+                               "b may be omitted when every offset is 0)")
+        return cls(M=data["M"], K=data["K"], A=data["A"], b=data.get("b"), W=data.get("W"), laws=data.get("laws"))
 
     def to_json_dict(self) -> dict[str, Any]:
         """Exact JSON-ready dictionary (entries as strings such as ``"1/3"``).
