@@ -32,6 +32,7 @@ NAMES = (
     "fig4_8_numerical_nnm.ipynb",
     "forced_response.ipynb",
     "hertz_backbone.ipynb",
+    "peer_nlvib02.ipynb",
     "peer_sdnd123.ipynb",
     "runtime_vs_error.ipynb",
     "validity_time.ipynb",
@@ -54,6 +55,7 @@ PLOT_FUNCTIONS = {
     "runtime_vs_error.ipynb": set(),
     "forced_response.ipynb": {"frequency_response", "spectrum"},
     "peer_sdnd123.ipynb": {"branch"},
+    "peer_nlvib02.ipynb": {"frequency_response"},
 }
 #: the figures (image/png outputs) each executed notebook shows, at least
 FIGURES = {
@@ -66,6 +68,7 @@ FIGURES = {
     "runtime_vs_error.ipynb": 3,
     "forced_response.ipynb": 3,
     "peer_sdnd123.ipynb": 1,
+    "peer_nlvib02.ipynb": 3,
 }
 #: rich displays of results (the last expression of a cell): (mime type, fragments that one such output contains)
 DISPLAYS = {
@@ -87,6 +90,7 @@ DISPLAYS = {
         ("text/latex", [r"\varepsilon F \cos \Omega t", r"\operatorname{acos}{\left(\frac{1}{5 A} \right)}"]),
     ],
     "peer_sdnd123.ipynb": [("text/html", ['<table class="lindstedt">', "<b>NNMBranch: "])],
+    "peer_nlvib02.ipynb": [("text/html", ['<table class="lindstedt">', "<b>FrequencyResponse: "])],
     "hertz_backbone.ipynb": [
         ("text/latex", ["Stretched contact arc", r"|u - b|^{3/2}"]),
         ("text/html", ['<table class="lindstedt">', "<b>StretchedArcSeries"]),
@@ -146,7 +150,7 @@ def _client_modules():
 
 
 #: notebooks taking 5–20 s each: executed by `pytest -m slow` (CI runs it) and by every build of the docs site
-HEAVY = ("backbone.ipynb", "hertz_backbone.ipynb", "peer_sdnd123.ipynb")
+HEAVY = ("backbone.ipynb", "hertz_backbone.ipynb", "peer_sdnd123.ipynb", "peer_nlvib02.ipynb")
 
 
 @pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.slow) if name in HEAVY else name for name in NAMES])
