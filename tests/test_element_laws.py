@@ -76,7 +76,6 @@ def test_what_takes_unilateral_springs_only_refuses_other_laws_naming_the_way_ou
     system = _cubic_chain().system
     attempts = [
         lambda: ExactFlow(system, 0.5),
-        lambda: lindstedt.nnm(system, 1, a0=1, order=1),
         lambda: lindstedt.all_modes_first_order(system, [1.0, 0.5]),
         lambda: lindstedt.numerics.ForcedFlow(_cubic_chain(), 0.5),
     ]

@@ -12,7 +12,9 @@ exact calculus of such branches with coefficients in any sympy domain
 (``QQ``, a fraction field ``QQ(π, β, …)``, ``RealField``) or in the
 :class:`~lindstedt.algebra.contact_field.ContactField` (σ² + κ² = 1 built in):
 
-* sums, scalar multiples, derivatives, products (of branches with integer harmonics);
+* sums, scalar multiples, derivatives, products (integer harmonics exactly; the non-integer harmonics
+  ``r_k`` of an N-dof system's modal components in a ``RealField``, sums and differences of harmonics
+  snapped to a common grid so that one frequency reached by two paths is one term);
 * evaluation at a point whose ``cos(j s0)``, ``sin(j s0)`` are known
   (:class:`EvaluationPoint`, using the Chebyshev recurrences from cos s0, sin s0),
   remembered per branch and point (the hierarchy evaluates the derivatives of every
@@ -37,6 +39,34 @@ __all__ = ["Branch", "EvaluationPoint"]
 # A term key is (harmonic j >= 0, parity 0 = cos / 1 = sin, power m >= 0); (0, 1, m) never occurs.
 TermKey = tuple[int, int, int]
 _RationalTerms = tuple[tuple[TermKey, Any], ...]
+
+
+#: a RealField harmonic is snapped to this many bits fewer than the field's precision (to an integer within it)
+_SNAP_BITS = 24
+
+
+def _snapped(harmonic: Any, domain: Any) -> Any:
+    """A sum or difference of RealField harmonics on a common grid: the integer it equals to ``_SNAP_BITS`` bits
+    below the field's precision, else its value rounded to that many bits fewer (``(r + 1) − 1`` is ``r``)."""
+    from mpmath.libmp import normalize, round_nearest
+
+    nearest = int(round(float(harmonic)))
+    if abs(harmonic - nearest) <= abs(harmonic) * 2.0 ** (_SNAP_BITS - domain.precision) + 2.0 ** (-domain.precision):
+        return nearest
+    sign, mantissa, exponent, bits = harmonic._mpf_
+    return domain.convert(sympy.Float._new(normalize(sign, mantissa, exponent, bits, domain.precision - _SNAP_BITS,
+                                                               round_nearest), domain.precision))
+
+
+def _resonant(harmonic: Any, frequency: Any) -> bool:
+    """ν = r, exactly or (a RealField harmonic) to the grid of :func:`_snapped`."""
+    if harmonic == frequency:
+        return True
+    if isinstance(harmonic, int) and isinstance(frequency, int):
+        return False
+    precision = getattr(getattr(frequency, "context", None), "prec", None) or getattr(
+        getattr(harmonic, "context", None), "prec", None)
+    return precision is not None and abs(harmonic - frequency) <= abs(frequency) * 2.0 ** (_SNAP_BITS - precision)
 
 
 def _add_into(target: dict, key: TermKey, value: Any) -> None:
@@ -88,7 +118,8 @@ def _general_oscillator_inverse(key: tuple, frequency: Any, domain: Any, memo: d
         return memo[key]
     harmonic, parity, power = key
     result: dict = {}
-    if harmonic == frequency:
+    if _resonant(harmonic, frequency):
+        harmonic = frequency
         top = (harmonic, 1 - parity, power + 1)
         sign = 1 if parity == 0 else -1
         scale = domain.one / (domain.convert(2 * (power + 1)) * frequency)
@@ -277,7 +308,7 @@ class Branch:
         return Branch(self.domain, result)
 
     def __mul__(self, other: "Branch") -> "Branch":
-        """Product of two branches with integer harmonics (product-to-sum; powers of s add).
+        """Product of two branches (product-to-sum; powers of s add; RealField harmonics snapped, :func:`_snapped`).
 
         Examples
         --------
@@ -290,21 +321,22 @@ class Branch:
         half = self.domain.convert(QQ(1, 2))
         for (j, parity, power), value in self.terms.items():
             for (k, other_parity, other_power), other_value in other.terms.items():
-                if not (isinstance(j, int) and isinstance(k, int)):
-                    raise TypeError("products of branches need integer harmonics")
                 product = value * other_value * half
                 exponent = power + other_power
-                difference = j - k
+                if isinstance(j, int) and isinstance(k, int):
+                    difference, total = j - k, j + k
+                else:
+                    difference, total = _snapped(j - k, self.domain), _snapped(j + k, self.domain)
                 # cos·cos = (cos(j−k) + cos(j+k))/2; sin·sin = (cos(j−k) − cos(j+k))/2;
                 # sin_j·cos_k = (sin(j+k) + sin(j−k))/2; cos_j·sin_k = (sin(j+k) − sin(j−k))/2
                 if parity == other_parity:
                     _add_into(result, (abs(difference), 0, exponent), product)
-                    _add_into(result, (j + k, 0, exponent), product if parity == 0 else -product)
+                    _add_into(result, (total, 0, exponent), product if parity == 0 else -product)
                 else:
                     sine_sign = 1 if parity == 1 else -1  # sign of sin(j−k) in the sum
                     if difference < 0:
                         sine_sign = -sine_sign
-                    _add_into(result, (j + k, 1, exponent), product)
+                    _add_into(result, (total, 1, exponent), product)
                     _add_into(result, (abs(difference), 1, exponent), product if sine_sign > 0 else -product)
         return Branch(self.domain, result)
 

@@ -18,11 +18,12 @@ trigonometric branch (:mod:`lindstedt.algebra.branch`), continued past the
 piece's ends.  With ``Ω² = Σ A_n ε̂^n`` order n reads, component by component,
 
     W_{n,k}'' + r_k² W_{n,k} = A_n δ_kj cos s − Σ_{i<n} A_i W_{n−i,k}'' − (L_p W_{n−1})_k − δ_{n1} (m_p)_k
-                                − Σ_m c_{p,m} [W^m]_{n−1}      (N = 1, a polynomial contact law)
+                                − Σ_e g_{e,k} Σ_m c_{e,m} [(c_e · W)^m]_{n−1}      (polynomial element laws)
 
-(``[W^m]_n`` is the ε̂ⁿ coefficient of (Σ ε̂^i W_i)^m: products of branches of lower
-orders on the same piece, still quasi-trigonometric, so a polynomial law on a
-piece keeps every branch analytic and continued past the piece's ends).
+(``[y^m]_n`` is the ε̂ⁿ coefficient of (Σ ε̂^i y_i)^m for an element's deformation ``y = c_e · W``
+(the 1-dof law acts on W itself, N-dof elements on a projection of the modal coordinates):
+products of branches of lower orders on the same piece, still quasi-trigonometric, so a
+polynomial law on a piece keeps every branch analytic and continued past the piece's ends).
 
 Unknowns of order n: ``A_n``, the homogeneous parts ``c cos(r_k s) + d sin(r_k s)``
 of every component on every piece, and the boundary shifts ``σ_{i,n}``.
@@ -69,18 +70,20 @@ __all__ = ["BranchHierarchy", "BranchSystem", "ContactState", "FloatBranches", "
 
 @dataclass(frozen=True)
 class ContactState:
-    """One contact state: the law ε̂ (L W + m + Σ_m c_m W^m) on a piece of [0, π] (rows of domain elements).
+    """One contact state: the law ε̂ (L W + m + Σ_e g_e Σ_m c_{e,m} (c_e · W)^m) on a piece of [0, π] (rows of
+    domain elements).
 
-    ``powers`` lists ``(m, c_m)``, m ≥ 2, of a polynomial contact law; it acts on a
-    single component (N = 1: the 1-dof oscillator with a piecewise-polynomial f).
     ``rank_one`` lists pairs ``(g, c)`` adding ``g cᵀ`` to L (``stiffness`` holds the dense
     rest, or is empty): the N-dof normal form's ``L_p = Σ_{i active} G_i B_iᵀ``, applied as
     one projection ``c · W`` and one rank-one update per pair, O(N) instead of O(N²).
+    ``elements`` lists ``(g, c, ((m, c_m), …))``, m ≥ 2: the higher powers of a polynomial law acting on
+    the deformation ``c · W`` with the force direction g — the 1-dof oscillator's piecewise-polynomial f is
+    ``((1,), (1,), …)``, an N-dof element's ``(G_i, B_i, …)``.
     """
 
     stiffness: tuple[tuple[Any, ...], ...]
     load: tuple[Any, ...]
-    powers: tuple[tuple[int, Any], ...] = ()
+    elements: tuple[tuple[tuple[Any, ...], tuple[Any, ...], tuple[tuple[int, Any], ...]], ...] = ()
     rank_one: tuple[tuple[tuple[Any, ...], tuple[Any, ...]], ...] = ()
 
 
@@ -342,7 +345,7 @@ class BranchHierarchy(LazyOrders):
         ]
         self._lag = int(any(boundary.grazing for boundary in system.boundaries))
         self._derivatives: dict[tuple[int, int, int, int], Branch] = {}
-        self._law_powers: dict[tuple[int, int, int], Branch] = {}
+        self._law_powers: dict[tuple[int, int, int, int], Branch] = {}
         # per stretched arc (first, last piece): its length ℓ_n (ℓ = s_1* or π − s_L*), μ_n = [Ω²/ℓ²]_n and
         # Q_n = [Y'(1)/ℓ]_n, the slope it hands to its neighbour (Q_0 = −sin β)
         self._arc_data: list[dict[str, list[Any]] | None] = []
@@ -410,16 +413,24 @@ class BranchHierarchy(LazyOrders):
         arcs = tuple(None if arc is None else arc.float_arc(highest) for arc in self.system.arcs)
         return FloatBranches(terms, shifts, arcs)
 
-    def _law_power(self, piece: int, power: int, order: int) -> Branch:
-        """[W^power]_order on ``piece`` (N = 1): Σ_i [W^{power−1}]_i W_{order−i}, memoised."""
-        key = (piece, power, order)
+    def _law_power(self, piece: int, element: int, power: int, order: int) -> Branch:
+        """[y^power]_order on ``piece`` for the deformation ``y = c · W`` of ``element``:
+        Σ_i [y^{power−1}]_i y_{order−i}, memoised (y_n = W_{n,k} itself where c is the unit vector e_k)."""
+        key = (piece, element, power, order)
         if key not in self._law_powers:
             if power == 1:
-                result = self._branches[order][piece][0]
+                coupling = self.system.states[piece].elements[element][1]
+                nonzero = [k for k, weight in enumerate(coupling) if weight]
+                branches = self._branches[order][piece]
+                if len(nonzero) == 1 and coupling[nonzero[0]] == self._domain.one:
+                    result = branches[nonzero[0]]
+                else:
+                    result = _combination(self._domain, [branches[k] for k in nonzero], [coupling[k] for k in nonzero])
             else:
                 result = Branch(self._domain)
                 for i in range(order + 1):
-                    result = result + self._law_power(piece, power - 1, i) * self._branches[order - i][piece][0]
+                    result = result + self._law_power(piece, element, power - 1, i) * \
+                        self._law_power(piece, element, 1, order - i)
             self._law_powers[key] = result
         return self._law_powers[key]
 
@@ -549,8 +560,11 @@ class BranchHierarchy(LazyOrders):
                 if order == system.gauge and state.load[k]:
                     rhs = rhs - Branch.constant(domain, state.load[k])
                 if order >= system.gauge:
-                    for power, coefficient in state.powers:
-                        rhs = rhs - self._law_power(piece, power, order - system.gauge).scale(coefficient)
+                    for element, (forcing, _, powers) in enumerate(state.elements):
+                        if forcing[k]:
+                            for power, coefficient in powers:
+                                rhs = rhs - self._law_power(piece, element, power, order - system.gauge).scale(
+                                    coefficient * forcing[k])
                 components_rhs.append(rhs.oscillator_particular_solution(system.ratios[k]))
             particular.append(components_rhs)
 

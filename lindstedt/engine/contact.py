@@ -29,7 +29,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Any
+from typing import Any, Sequence
 
 import mpmath
 import sympy
@@ -48,6 +48,12 @@ from .._precision import locked, workdps
 __all__ = ["ContactBoundary", "PiecewiseNormalForm", "contact_normal_form"]
 
 _ARC_VARIABLE = sympy.Symbol("y", real=True)  # the normalised displacement in an arc's analytic law
+
+
+def _powers_on_the_displacement(domain: Any, law: Sequence[Any]) -> tuple:
+    """The powers m ≥ 2 of a piece's polynomial law as the one element of the branch system, acting on W itself."""
+    powers = tuple((power, value) for power, value in enumerate(law) if power >= 2 and value)
+    return (((domain.one,), (domain.one,), powers),) if powers else ()
 
 
 @dataclass(frozen=True)
@@ -433,8 +439,7 @@ def _assemble(
         ratios=(None,),
         mode=0,
         states=tuple(
-            ContactState(((law[1],),), (law[0],), tuple((power, value) for power, value in enumerate(law) if power >= 2 and value))
-            for law in piece_laws
+            ContactState(((law[1],),), (law[0],), _powers_on_the_displacement(domain, law)) for law in piece_laws
         ),
         boundaries=tuple(moving),
         zero_point=zero,

@@ -28,6 +28,7 @@ refined in multiprecision), and ``L_p`` enters the hierarchy as its rank-one ter
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -36,7 +37,7 @@ import numpy as np
 import sympy
 from sympy import RealField
 
-from .._errors import ProblemError, ResonanceError
+from .._errors import ProblemError, ResonanceError, UnsupportedNonlinearityError
 from .._precision import locked
 from ..problems.system import UnilateralSystem
 from ..algebra.branch import EvaluationPoint
@@ -50,18 +51,44 @@ _GRAZING_TOLERANCE = 1e-12
 
 @dataclass(frozen=True)
 class SpringAtOrderZero:
-    """How spring i meets the linear mode: its coupling a0 B_ij, κ_i = b_i/(a0 B_ij) and status."""
+    """How breakpoint p of element i's law meets the linear mode: the deformation ``a0 B_ij cos s − b_i`` reaches
+    p where ``cos s = κ = (b_i + p)/(a0 B_ij)``; its coupling a0 B_ij, κ and status (a unilateral spring is an
+    element with the one breakpoint 0).  ``index`` numbers the (element, breakpoint) pairs."""
 
     index: int
     coupling: Any
     kappa: Any | None
-    orientation: int  # +1: contact for cos s > κ (near s = 0); -1: contact for cos s < κ
-    status: str  # "crossing", "grazing", "never", "always"
+    orientation: int  # +1: the deformation is above p for cos s > κ (near s = 0); -1: for cos s < κ
+    status: str  # "crossing", "grazing", "never" (the deformation stays below p), "always" (above)
+    element: int = 0
+    breakpoint: int = 0  # index of p among the element law's breakpoints
 
-    @property
-    def touches_from_contact(self) -> bool:
-        """A grazing spring in contact over the rest of the orbit (it touches its gap at one turning point)."""
-        return self.status == "grazing" and (self.kappa > 0) != (self.orientation > 0)
+
+@dataclass(frozen=True)
+class _PiecewisePolynomial:
+    """An element's law as increasing breakpoints and one polynomial (coefficients by degree) per interval."""
+
+    breakpoints: tuple[Any, ...]
+    pieces: tuple[tuple[Any, ...], ...]
+
+    def interval(self, deformation: Any) -> int:
+        """Index of the interval holding a deformation (not on a breakpoint)."""
+        return sum(1 for point in self.breakpoints if deformation > point)
+
+
+def _piecewise_polynomial(law: sympy.Expr, convert: Any) -> _PiecewisePolynomial:
+    """Breakpoints and polynomial pieces of an element's law, or an UnsupportedNonlinearityError naming shooting."""
+    from ..problems.piecewise_linear import decompose_piecewise, has_non_polynomial_law
+    from ..problems.system import LAW_VARIABLE
+
+    if has_non_polynomial_law(law, LAW_VARIABLE):
+        raise UnsupportedNonlinearityError(
+            f"the N-dof strained-coordinates NNM takes laws that are polynomial between breakpoints; {law} is not "
+            "(a fractional power or an analytic function of u): compute its NNMs by shooting (nnm_point, "
+            "continue_nnm), or expand the one-degree-of-freedom problem with lindstedt.expand")
+    intervals = decompose_piecewise(law, LAW_VARIABLE)
+    return _PiecewisePolynomial(tuple(convert(interval.upper) for interval in intervals[:-1]),
+                                tuple(tuple(convert(c) for c in interval.coefficients) for interval in intervals))
 
 
 @dataclass(frozen=True)
@@ -108,15 +135,16 @@ def _small_divisors(ratios: list[Any], mode: int) -> tuple[tuple[int, int, Any],
     return tuple(divisors)
 
 
-def _classify(index: int, coupling: Any, gap: Any, digits: int, mode: int) -> SpringAtOrderZero:
+def _classify(index: int, coupling: Any, gap: Any, digits: int, mode: int, element: int = 0,
+              breakpoint: int = 0) -> SpringAtOrderZero:
     scale = max(abs(coupling), abs(gap), 1)
     if abs(coupling) <= mpmath.mpf(10) ** (-digits + 5) * scale:
         if gap == 0:
             raise ProblemError(
-                f"spring {index + 1} is not moved by mode {mode + 1} and has zero gap: its contact is degenerate; "
-                "give it a nonzero gap or choose another mode"
+                f"element {element + 1} is not moved by mode {mode + 1} and rests on a breakpoint of its law (a "
+                "spring with zero gap): its contact is degenerate; give it a nonzero gap or choose another mode"
             )
-        return SpringAtOrderZero(index, coupling, None, 1, "always" if gap < 0 else "never")
+        return SpringAtOrderZero(index, coupling, None, 1, "always" if gap < 0 else "never", element, breakpoint)
     kappa = gap / coupling
     orientation = 1 if coupling > 0 else -1
     # |κ| within 1e-12 of 1: the contact lasts ~1e-6 of a period, valid only for ε ≪ 1e-12 as a
@@ -129,7 +157,7 @@ def _classify(index: int, coupling: Any, gap: Any, digits: int, mode: int) -> Sp
         status = "never"
     else:
         status = "always"
-    return SpringAtOrderZero(index, coupling, kappa, orientation, status)
+    return SpringAtOrderZero(index, coupling, kappa, orientation, status, element, breakpoint)
 
 
 @locked
@@ -154,50 +182,85 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
     G = [[domain.dtype(value) for value in row] for row in forcing_rows]  # G[k][i]
     forcing_columns = [tuple(G[k][i] for k in range(size)) for i in range(springs_count)]
     coupling_vectors = [tuple(B[i]) for i in range(springs_count)]
-    springs = tuple(_classify(i, a0 * B[i][mode], gaps[i], digits, mode) for i in range(springs_count))
+    distinct = {law: _piecewise_polynomial(law, convert) for law in set(system.laws)}
+    laws = [distinct[law] for law in system.laws]
+    # one candidate boundary per (element, breakpoint): the deformation a0 B_ij cos s − b_i reaches p at cos s = κ
+    springs = []
+    for i, law in enumerate(laws):
+        for t, point in enumerate(law.breakpoints):
+            springs.append(_classify(len(springs), a0 * B[i][mode], gaps[i] + point, digits, mode, i, t))
+    springs = tuple(springs)
     pi = domain.convert(sympy.N(sympy.pi, digits + 10))
     zero_point = EvaluationPoint(domain, domain.zero, domain.one, domain.zero)
     pi_point = EvaluationPoint(domain, pi, -domain.one, domain.zero)
+    binomials = {}
+
+    def element_law(i: int, interval: int) -> tuple[Any, Any, tuple[tuple[int, Any], ...]]:
+        """Element i's force on an interval of its law, in W: ``G_i f_i(a0 y − b_i)/a0 = G_i Σ_l e_l y^l``,
+        ``y = B_i · W``; returns (e_0, e_1, ((l, e_l), l ≥ 2))."""
+        coefficients = laws[i].pieces[interval]
+        shift = -gaps[i]
+        terms = []
+        for l in range(len(coefficients)):
+            total = domain.zero
+            for m in range(l, len(coefficients)):
+                if coefficients[m]:
+                    key = (m, l)
+                    if key not in binomials:
+                        binomials[key] = domain.convert(math.comb(m, l))
+                    total += coefficients[m] * binomials[key] * shift ** (m - l)
+            terms.append(total * a0 ** (l - 1) if l else total / a0)
+        return terms[0], (terms[1] if len(terms) > 1 else domain.zero), \
+            tuple((l, e) for l, e in enumerate(terms) if l >= 2 and e)
 
     def assemble(crossed: dict[int, Any]) -> BranchSystem:
-        """The branch system; ``crossed`` maps a grazing spring the perturbed orbit passes to its σ_1."""
+        """The branch system; ``crossed`` maps a grazing boundary the perturbed orbit passes to its σ_1."""
         top = [s for s in springs if s.index in crossed and s.kappa > 0]
         bottom = [s for s in springs if s.index in crossed and s.kappa < 0]
         crossing = sorted((s for s in springs if s.status == "crossing"), key=lambda s: s.kappa.context.acos(s.kappa))
         boundaries, angles = [], []
         for spring in top:
-            boundaries.append(MovingBoundary(zero_point, tuple(a0 * B[spring.index][k] for k in range(size)), domain.zero, crossed[spring.index]))
+            boundaries.append(MovingBoundary(zero_point, tuple(a0 * B[spring.element][k] for k in range(size)), domain.zero, crossed[spring.index]))
         for spring in crossing:
             kappa = spring.kappa
             angle = kappa.context.acos(kappa)
             point = EvaluationPoint(domain, angle, kappa, kappa.context.sqrt((1 - kappa) * (1 + kappa)))
-            boundaries.append(MovingBoundary(point, tuple(a0 * B[spring.index][k] for k in range(size)), point.sin_multiple(1)))
+            boundaries.append(MovingBoundary(point, tuple(a0 * B[spring.element][k] for k in range(size)), point.sin_multiple(1)))
             angles.append(angle)
         for spring in bottom:
-            boundaries.append(MovingBoundary(pi_point, tuple(a0 * B[spring.index][k] for k in range(size)), domain.zero, crossed[spring.index]))
-        # One contact state per piece: a sample angle inside it decides the active springs (a crossed
-        # grazing spring flips on its short piece next to the turning point).
+            boundaries.append(MovingBoundary(pi_point, tuple(a0 * B[spring.element][k] for k in range(size)), domain.zero, crossed[spring.index]))
+        # One contact state per piece: a sample angle inside it decides the interval of every element's law (on
+        # the short piece next to a turning point that a crossed grazing boundary cuts off, the interval beyond
+        # that boundary's breakpoint).
         limits = [domain.zero] + angles + [pi]
         samples = [(lower + upper) / 2 for lower, upper in zip(limits, limits[1:])]
-        flipped = [set() for _ in samples]
+        flipped: list[set[int]] = [set() for _ in samples]
         if top:
-            samples.insert(0, domain.zero)
+            samples.insert(0, samples[0])
             flipped.insert(0, {s.index for s in top})
         if bottom:
-            samples.append(pi)
+            samples.append(samples[-1])
             flipped.append({s.index for s in bottom})
         states = []
         for middle, flips in zip(samples, flipped):
             cosine = middle.context.cos(middle)
-            active = [
-                s.index
-                for s in springs
-                if (s.status == "always" or s.touches_from_contact or (s.status == "crossing" and ((cosine > s.kappa) if s.orientation > 0 else (cosine < s.kappa))))
-                != (s.index in flips)
-            ]
-            # L_p = Σ_{i active} G_i B_iᵀ as rank-one terms (never an N × N matrix)
-            load = tuple(-sum((G[k][i] * gaps[i] for i in active), domain.zero) / a0 for k in range(size))
-            states.append(ContactState((), load, rank_one=tuple((forcing_columns[i], coupling_vectors[i]) for i in active)))
+            load = [domain.zero] * size
+            rank_one, elements = [], []
+            for i, law in enumerate(laws):
+                interval = law.interval(a0 * B[i][mode] * cosine - gaps[i])
+                for spring in springs:
+                    if spring.index in flips and spring.element == i:  # across the grazed breakpoint
+                        interval = spring.breakpoint + 1 if interval == spring.breakpoint else spring.breakpoint
+                constant, linear, powers = element_law(i, interval)
+                if constant:
+                    for k in range(size):
+                        load[k] += G[k][i] * constant
+                if linear:  # L_p = Σ_i e_1 G_i B_iᵀ as rank-one terms (never an N × N matrix)
+                    rank_one.append((forcing_columns[i], coupling_vectors[i] if linear == domain.one
+                                     else tuple(linear * c for c in coupling_vectors[i])))
+                if powers:
+                    elements.append((forcing_columns[i], coupling_vectors[i], powers))
+            states.append(ContactState((), tuple(load), elements=tuple(elements), rank_one=tuple(rank_one)))
         return BranchSystem(
             domain=domain,
             ratios=tuple(None if k == mode else ratio for k, ratio in enumerate(ratios)),
@@ -214,14 +277,15 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
     crossed = {}
     grazing = [s for s in springs if s.status == "grazing"]
     if grazing:
-        # A grazing spring touches its gap at a turning point β (double root of the order-zero gap).  The
-        # order-one orbit decides: with η = ε̂^{1/2}, s* = β + σ_1 η, the gap's ε̂ term g_1 = Σ_k c_k W_{1,k}(β)
-        # and W_0''(β) = −cos β give g_1 − c_j cos β σ_1²/2 = 0; the perturbed orbit passes iff σ_1² > 0.
+        # A grazing boundary touches its breakpoint at a turning point β (double root of the order-zero
+        # deformation − p).  The order-one orbit decides: with η = ε̂^{1/2}, s* = β + σ_1 η, the deformation's ε̂
+        # term g_1 = Σ_k c_k W_{1,k}(β) and W_0''(β) = −cos β give g_1 − c_j cos β σ_1²/2 = 0; the perturbed
+        # orbit passes iff σ_1² > 0.
         first_order = BranchHierarchy(branch_system).branches(1)
         for spring in grazing:
             top = spring.kappa > 0
             point, piece = (zero_point, 0) if top else (pi_point, len(branch_system.states) - 1)
-            coupling = [a0 * B[spring.index][k] for k in range(size)]
+            coupling = [a0 * B[spring.element][k] for k in range(size)]
             gap = sum((coupling[k] * first_order[piece][k].evaluate(point) for k in range(size)), domain.zero)
             squared = 2 * gap / (coupling[mode] * point.cos_multiple(1))
             if squared > mpmath.mpf(10) ** (-digits // 2) * max(1, abs(gap)):

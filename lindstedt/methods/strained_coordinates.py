@@ -1,4 +1,4 @@
-"""Nonlinear normal modes by strained coordinates:  M X'' + K X + ε W (A X − b)_+ = 0 (seed §4).
+"""Nonlinear normal modes by strained coordinates:  M X'' + K X + ε Σ_i w_i f_i(a_iᵀ X − b_i) = 0 (seed §4).
 
 The method :class:`StrainedCoordinatesNNM` (verb ``expand``) and its shortcut
 :func:`nnm`.  The NNM of mode j is sought with one strained time ``s = ω t``,
@@ -80,7 +80,10 @@ class StrainedCoordinatesNNM:
         releases = tuple(
             hierarchy.release(steps, k) * form.amplitude * root**steps if order >= 1 else zero for k in range(system.n_dof)
         )
-        roots = tuple({"crossing": "simple", "grazing": "double"}.get(spring.status, "none") for spring in form.springs)
+        # per element: a double root where one of its breakpoints is grazed, simple where one is crossed
+        statuses = [{spring.status for spring in form.springs if spring.element == i} for i in range(system.n_springs)]
+        roots = tuple("double" if "grazing" in found else "simple" if "crossing" in found else "none"
+                      for found in statuses)
         return NNMExpansion(
             problem=problem,
             order=order,
@@ -119,6 +122,8 @@ def release_amplitudes_by_series(system: UnilateralSystem, mode: int, a0: Any, *
     from ..algebra.fourier import contact_ramp_coefficient_mp
     from ..algebra.series import series_sum
 
+    system.require_unilateral("the Fourier-series cross-check of the a_k (release_amplitudes_by_series)")
+
     modes = system.modes()
     frequencies, shapes = modes.frequencies, modes.shapes
     j = mode - 1
@@ -148,7 +153,8 @@ def release_amplitudes_by_series(system: UnilateralSystem, mode: int, a0: Any, *
 
 @locked
 def nnm(system: UnilateralSystem, mode: int, a0: Any, order: int = 2, *, a1: Any = 0, precision: int = 30) -> NNMExpansion:
-    """Nonlinear normal mode of ``M X'' + K X + ε W (A X − b)_+ = 0`` grown from ``mode`` (strained coordinates).
+    """Nonlinear normal mode of ``M X'' + K X + ε Σ_i w_i f_i(a_iᵀ X − b_i) = 0`` grown from ``mode`` (strained
+    coordinates; unilateral springs ``f_i = Max(0, u)`` by default, any law polynomial between breakpoints).
 
     Examples
     --------

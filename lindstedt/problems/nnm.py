@@ -1,14 +1,16 @@
-"""The NNM problem: the mode j of  M X'' + K X + ε W (A X − b)_+ = 0  released at rest at u_j(0) = a0 + ε a1."""
+"""The NNM problem: the mode j of  M X'' + K X + ε Σ_i w_i f_i(a_iᵀ X − b_i) = 0  released at rest at u_j(0) = a0 + ε a1
+(every law f_i polynomial between its breakpoints: unilateral springs, cubic springs, gaps, jumps, contact pieces)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from typing import Any
 
-from .._errors import ProblemError
+from .._errors import ProblemError, UnsupportedNonlinearityError
 from .._precision import locked_methods
 from .parsing import parse_real
-from .system import UnilateralSystem
+from .piecewise_linear import has_non_polynomial_law
+from .system import LAW_VARIABLE, UnilateralSystem
 
 __all__ = ["NNMProblem"]
 
@@ -16,7 +18,7 @@ __all__ = ["NNMProblem"]
 @locked_methods()
 @dataclass(frozen=True)
 class NNMProblem:
-    """The NNM grown from linear mode j of ``M X'' + K X + ε W (A X − b)_+ = 0``, released at rest.
+    """The NNM grown from linear mode j of ``M X'' + K X + ε Σ_i w_i f_i(a_iᵀ X − b_i) = 0``, released at rest.
 
     Release: modal coordinate u_j(0) = a0 + ε a1 of mode j; the other modal
     coordinates are what the NNM makes them (u_k(0) = ε a_k + …), X'(0) = 0.
@@ -45,7 +47,13 @@ class NNMProblem:
     def __post_init__(self) -> None:
         if not isinstance(self.system, UnilateralSystem):
             raise ProblemError("system must be a UnilateralSystem (see UnilateralSystem.from_json_dict)")
-        self.system.require_unilateral("the strained-coordinates NNM expansion (lindstedt.nnm)")
+        for law in self.system.laws:
+            if has_non_polynomial_law(law, LAW_VARIABLE):
+                raise UnsupportedNonlinearityError(
+                    f"the N-dof strained-coordinates NNM (lindstedt.nnm) takes laws that are polynomial between "
+                    f"breakpoints; {law} is not (a fractional power or an analytic function of u): compute its NNMs "
+                    "by shooting (lindstedt.nnm_point, continue_nnm), or expand one degree of freedom with "
+                    "lindstedt.expand")
         if isinstance(self.mode, bool) or not isinstance(self.mode, int) or not 1 <= self.mode <= self.system.n_dof:
             raise ProblemError(f"mode must be an integer between 1 and {self.system.n_dof}, got {self.mode!r}")
         amplitude = parse_real(self.a0, what="a0")

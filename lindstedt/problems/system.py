@@ -104,13 +104,14 @@ class UnilateralSystem:
     laws : sequence of str, optional
         One law ``f_i(u)`` per row of A, the element's force ``ε W_i f_i(A_i X − b_i)`` (default: every
         element the unilateral spring ``Max(0, u)``, the problem above).  Any law of the 1-dof library
-        (``"u**3"``, ``"Max(0, u)**(3/2)"``, …), read by the one parser.  The exact flow, NNM shooting
-        and the strained-coordinates NNMs take unilateral springs only (a typed error says so); forced
-        responses integrate any law (:class:`~lindstedt.numerics.SmoothForcedFlow`).
+        (``"u**3"``, ``"Max(0, u)**(3/2)"``, …), read by the one parser.  The exact event-driven flow takes
+        unilateral springs only (a typed error says so); NNM shooting and forced responses integrate any law
+        (:class:`~lindstedt.numerics.SmoothForcedFlow`), the strained-coordinates NNMs (:func:`lindstedt.nnm`)
+        take every law that is polynomial between breakpoints (gaps, jumps, cubic springs, contact pieces).
 
     Entries may be ints, floats, ``fractions.Fraction``, exact strings such as
-    ``"1/3"`` or ``"sqrt(2)"``, or sympy numbers; decimal floats and strings are
-    read exactly (``0.1`` → ``1/10``).
+    ``"1/3"`` or ``"sqrt(2)"``, or sympy numbers; strings are read exactly (``"0.1"`` → ``1/10``), a
+    float is its exact binary value (``0.1`` → ``3602879701896397/36028797018963968``).
 
     Attributes
     ----------
