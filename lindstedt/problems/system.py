@@ -12,7 +12,9 @@
 
   ``E = ½ X'ᵀ M X' + ½ Xᵀ K X + ½ ε Σ_i (A_i X − b_i)_+²``.
 
-``(·)_+ = max(·, 0)`` acts entrywise.  Every matrix is stored twice: exactly
+``(·)_+ = max(·, 0)`` acts entrywise.  Elements may carry other laws f_i (``ε W f(A X − b)``), and a polynomial force
+``ε g(X)`` (``couplings``, one polynomial in ``x1 … xN`` per degree of freedom) is turned exactly into elements
+``(a_iᵀ X)^d`` by :mod:`~lindstedt.problems.couplings`.  Every matrix is stored twice: exactly
 (``sympy.ImmutableMatrix``; the string ``"0.1"`` is read as ``1/10``, the float
 ``0.1`` as its exact binary value) and as a read-only float ``numpy`` array (the correctly rounded
 values of the exact entries).  The N-dof setting is section 4 of the seed
@@ -31,13 +33,14 @@ import sympy
 
 from .._errors import ProblemError, UnsupportedNonlinearityError
 from .._precision import cached_property, locked, locked_methods
+from .couplings import coupling_elements, read_couplings
 from .matrices import _check_symmetric_positive_definite, _exact_matrix, _exact_scalar, _exactly_equal, _float_array
 from .modes import _float_modes, _high_precision_modes, _modal_coupling
 from .parsing import parse_expression
 
 __all__ = ["UnilateralSystem", "Modes", "OneDofUnilateral"]
 
-_JSON_KEYS = ("M", "K", "A", "b", "W", "laws")
+_JSON_KEYS = ("M", "K", "A", "b", "W", "laws", "couplings")
 #: the variable of an element's law f(u) (the oscillator's u)
 LAW_VARIABLE = sympy.Symbol("u", real=True)
 #: the law of a unilateral spring, the default of every element
@@ -108,6 +111,12 @@ class UnilateralSystem:
         unilateral springs only (a typed error says so); NNM shooting and forced responses integrate any law
         (:class:`~lindstedt.numerics.SmoothForcedFlow`), the strained-coordinates NNMs (:func:`lindstedt.nnm`)
         take every law that is polynomial between breakpoints (gaps, jumps, cubic springs, contact pieces).
+    couplings : sequence of str or sympy expressions, optional
+        A polynomial force ``ε g(X)``: one polynomial ``g_r`` per degree of freedom in the displacements ``x1 … xN``
+        (1-based; ``"0"`` where there is none), e.g. ``["x1**3", "x1**2*x2"]``, read by the one parser.  It is
+        turned exactly into elements ``ε w (aᵀ X)^d`` (law ``u**d``, offset 0; :mod:`~lindstedt.problems.couplings`),
+        appended after the rows of ``A`` (and columns of ``W``) given here, so every method taking elements takes
+        it.  Constant terms (loads) and linear terms (stiffness: K) are refused with the fix.
 
     Entries may be ints, floats, ``fractions.Fraction``, exact strings such as
     ``"1/3"`` or ``"sqrt(2)"``, or sympy numbers; strings are read exactly (``"0.1"`` → ``1/10``), a
@@ -121,6 +130,9 @@ class UnilateralSystem:
         Exact copies (``b_exact`` is a column).
     laws : tuple of sympy expressions
         The law of each element, in the variable ``u``.
+    couplings : tuple of sympy expressions or None
+        The polynomials ``g_r`` as given (expanded, exact), ``None`` without couplings; their elements are the
+        last rows of ``A_exact`` (columns of ``W_exact``, entries of ``b_exact`` and ``laws``).
 
     Raises
     ------
@@ -138,6 +150,11 @@ class UnilateralSystem:
     1/10
     >>> [round(float(x), 12) for x in system.modes().frequencies]
     [1.0, 1.732050807569]
+    >>> geometric = UnilateralSystem(M=[[1, 0], [0, 1]], K=[[2, -1], [-1, 2]], couplings=["x1**3", "x1**2*x2"])
+    >>> geometric.A_exact.tolist(), geometric.laws
+    ([[2, 1], [1, 1], [1, 0], [0, 1]], (u**3, u**3, u**3, u**3))
+    >>> geometric.W_exact.tolist()
+    [[0, 0, 1, 0], [1/6, -1/3, -1, 1/6]]
     """
 
     M: np.ndarray
@@ -151,9 +168,10 @@ class UnilateralSystem:
     b_exact: sympy.ImmutableMatrix
     W_exact: sympy.ImmutableMatrix
     laws: tuple[sympy.Expr, ...]
+    couplings: tuple[sympy.Expr, ...] | None
 
     def __init__(self, M: Any, K: Any, A: Any = (), b: Any | None = None, W: Any | None = None,
-                 laws: Any = None) -> None:
+                 laws: Any = None, couplings: Any = None) -> None:
         M_exact = _exact_matrix(M, "M", ndim=2)
         K_exact = _exact_matrix(K, "K", ndim=2)
         n = M_exact.rows
@@ -194,6 +212,15 @@ class UnilateralSystem:
         K_float = _float_array(K_exact)
         _check_symmetric_positive_definite(M_exact, M_float, "M", "mass matrix")
         _check_symmetric_positive_definite(K_exact, K_float, "K", "stiffness matrix")
+        element_laws = _element_laws(laws, m)
+        read = None if couplings is None else read_couplings(couplings, n)
+        derived = coupling_elements(read) if read else ()
+        if derived:  # the elements of ε g(X), after the given ones
+            A_exact = A_exact.col_join(sympy.ImmutableMatrix([list(a) for a, _, _ in derived]))
+            b_exact = b_exact.col_join(sympy.ImmutableMatrix.zeros(len(derived), 1))
+            W_exact = W_exact.row_join(sympy.ImmutableMatrix([list(w) for _, _, w in derived]).T)
+            element_laws += tuple(LAW_VARIABLE**d for _, d, _ in derived)
+        object.__setattr__(self, "_given_elements", m)
         for attribute, value in (
             ("M", M_float),
             ("K", K_float),
@@ -205,7 +232,8 @@ class UnilateralSystem:
             ("A_exact", A_exact),
             ("b_exact", b_exact),
             ("W_exact", W_exact),
-            ("laws", _element_laws(laws, m)),
+            ("laws", element_laws),
+            ("couplings", read),
         ):
             object.__setattr__(self, attribute, value)
 
@@ -249,7 +277,7 @@ class UnilateralSystem:
                 "(lindstedt.numerics.SmoothForcedFlow, chosen by forced_flow)")
 
     def _key(self) -> tuple:
-        return (self.M_exact, self.K_exact, self.A_exact, self.b_exact, self.W_exact, self.laws)
+        return (self.M_exact, self.K_exact, self.A_exact, self.b_exact, self.W_exact, self.laws, self.couplings)
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, UnilateralSystem):
@@ -261,8 +289,13 @@ class UnilateralSystem:
 
     def __repr__(self) -> str:
         coupling = "W=Aᵀ" if self.symmetric_coupling else "W≠Aᵀ"
-        laws = "" if self.unilateral else f", laws=[{', '.join(map(str, self.laws))}]"
-        return f"UnilateralSystem(N={self.n_dof}, m={self.n_springs}, {coupling}{laws})"
+        given = self.laws[:self._given_elements]
+        laws = "" if all(law == UNILATERAL for law in given) else f", laws=[{', '.join(map(str, given))}]"
+        if self.couplings is None:
+            return f"UnilateralSystem(N={self.n_dof}, m={self.n_springs}, {coupling}{laws})"
+        derived = self.n_springs - self._given_elements
+        return (f"UnilateralSystem(N={self.n_dof}, m={self.n_springs} ({derived} from couplings), {coupling}{laws}, "
+                f"couplings=[{', '.join(map(str, self.couplings))}])")
 
     # ------------------------------------------------------------ constructors
     @classmethod
@@ -274,6 +307,7 @@ class UnilateralSystem:
         mass: Any = 1,
         stiffness: Any = 1,
         elements: Iterable[Sequence[Any]] = (),
+        couplings: Any = None,
     ) -> "UnilateralSystem":
         """Chain of equal masses joined by equal springs, both ends fixed to walls.
 
@@ -294,6 +328,8 @@ class UnilateralSystem:
             Elements of any law f(u) of the 1-dof library between two masses: the force
             ``ε f(X_i − X_j − gap)`` pushes mass j and pulls mass i (``j = None``: between mass i and the
             ground).  They follow the unilateral springs in A.
+        couplings : sequence of str, optional
+            A polynomial force ``ε g(X)`` in ``x1 … xN`` (1-based), as for the constructor; its elements come last.
 
         Examples
         --------
@@ -361,7 +397,8 @@ class UnilateralSystem:
             gaps.append(_exact_scalar(spec[3] if len(spec) == 4 else 0, f"gap of element {k}"))
             laws.append(spec[2])
         unilateral_only = all(law is UNILATERAL for law in laws)
-        return cls(M=M, K=K, A=rows if rows else sympy.zeros(0, n), b=gaps, laws=None if unilateral_only else laws)
+        return cls(M=M, K=K, A=rows if rows else sympy.zeros(0, n), b=gaps, laws=None if unilateral_only else laws,
+                   couplings=couplings)
 
     @classmethod
     def one_dof(cls, omega0: Any, a: Any = 1, b: Any = 0) -> "UnilateralSystem":
@@ -400,19 +437,21 @@ class UnilateralSystem:
             raise ProblemError(f"from_json_dict expects a mapping with keys M, K, A, b (and optionally W), got {type(data).__name__}")
         unknown = sorted(set(data) - set(_JSON_KEYS))
         if unknown:
-            raise ProblemError(f"unknown keys {unknown} in the system definition; the keys are M, K, A, b and optional W "
-                               "and laws")
+            raise ProblemError(f"unknown keys {unknown} in the system definition; the keys are M, K, A, b and optional W, "
+                               "laws and couplings")
         missing = [key for key in ("M", "K", "A") if key not in data]
         if missing:
             raise ProblemError(f"the system definition lacks the keys {missing}; give M, K, A and b (A = [] for none; "
                                "b may be omitted when every offset is 0)")
-        return cls(M=data["M"], K=data["K"], A=data["A"], b=data.get("b"), W=data.get("W"), laws=data.get("laws"))
+        return cls(M=data["M"], K=data["K"], A=data["A"], b=data.get("b"), W=data.get("W"), laws=data.get("laws"),
+                   couplings=data.get("couplings"))
 
     def to_json_dict(self) -> dict[str, Any]:
         """Exact JSON-ready dictionary (entries as strings such as ``"1/3"``).
 
         ``W`` is written only when it differs from ``Aᵀ``, ``laws`` only when an element is not a unilateral
-        spring.
+        spring, ``couplings`` only when given (``A``, ``b``, ``W`` and ``laws`` then hold the given elements only: the
+        couplings' elements are derived again on reading).
 
         Examples
         --------
@@ -422,16 +461,20 @@ class UnilateralSystem:
         def matrix(exact: sympy.ImmutableMatrix) -> list[list[str]]:
             return [[_json_entry(exact[i, j]) for j in range(exact.cols)] for i in range(exact.rows)]
 
+        m = self._given_elements
+        A, W = self.A_exact[:m, :], self.W_exact[:, :m]
         data: dict[str, Any] = {
             "M": matrix(self.M_exact),
             "K": matrix(self.K_exact),
-            "A": matrix(self.A_exact),
-            "b": [_json_entry(self.b_exact[i, 0]) for i in range(self.n_springs)],
+            "A": matrix(A),
+            "b": [_json_entry(self.b_exact[i, 0]) for i in range(m)],
         }
-        if not self.symmetric_coupling:
-            data["W"] = matrix(self.W_exact)
-        if not self.unilateral:
-            data["laws"] = [str(law) for law in self.laws]
+        if not all(_exactly_equal(W[j, i], A[i, j]) for i in range(m) for j in range(self.n_dof)):
+            data["W"] = matrix(W)
+        if any(law != UNILATERAL for law in self.laws[:m]):
+            data["laws"] = [str(law) for law in self.laws[:m]]
+        if self.couplings is not None:
+            data["couplings"] = [str(g) for g in self.couplings]
         return data
 
     # ------------------------------------------------------------ quantities
