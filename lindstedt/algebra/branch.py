@@ -59,14 +59,17 @@ def _snapped(harmonic: Any, domain: Any) -> Any:
 
 
 def _resonant(harmonic: Any, frequency: Any) -> bool:
-    """ν = r, exactly or (a RealField harmonic) to the grid of :func:`_snapped`."""
+    """ν = r, exactly or (a RealField harmonic) to the grid of :func:`_snapped` (its spacing, 2^(_SNAP_BITS −
+    precision) relative, with a margin of 16: a snapped ν lies up to half a spacing from the r it stands for, and
+    treating it as non-resonant would give a particular solution of size 1/(r² − ν²) ~ 1e26 that the homogeneous
+    part cancels only in exact arithmetic)."""
     if harmonic == frequency:
         return True
     if isinstance(harmonic, int) and isinstance(frequency, int):
         return False
     precision = getattr(getattr(frequency, "context", None), "prec", None) or getattr(
         getattr(harmonic, "context", None), "prec", None)
-    return precision is not None and abs(harmonic - frequency) <= abs(frequency) * 2.0 ** (_SNAP_BITS - precision)
+    return precision is not None and abs(harmonic - frequency) <= abs(frequency) * 2.0 ** (_SNAP_BITS + 4 - precision)
 
 
 def _add_into(target: dict, key: TermKey, value: Any) -> None:

@@ -57,15 +57,15 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 import mpmath
-import numpy as np
 
 from .._errors import ResonanceError
 from ..algebra.branch import Branch, EvaluationPoint
-from .._precision import cached_property, locked
+from .._precision import locked
 from .orders import LazyOrders, shift_powers
-from .stretched import FloatArc
+from .float_branches import FloatBranches
+from .stretched import VectorArc
 
-__all__ = ["BranchHierarchy", "BranchSystem", "ContactState", "FloatBranches", "MovingBoundary"]
+__all__ = ["BranchHierarchy", "BranchSystem", "ContactState", "MovingBoundary"]
 
 
 @dataclass(frozen=True)
@@ -215,90 +215,6 @@ def solve_linear(matrix: list[list[Any]], vector: list[Any], domain: Any, order:
     return solution
 
 
-@dataclass(frozen=True)
-class FloatBranches:
-    """Float image of W_0 … W_N for fast evaluation between the moving contact angles.
-
-    ``terms[n][p][k]`` lists ``(frequency, parity, power, value)`` of W_{n,k} on piece p;
-    ``shifts[n][i]`` is σ_{i,n} (n = 0: the contact angle β_i).
-    """
-
-    terms: tuple
-    shifts: tuple
-    arcs: tuple[FloatArc | None, FloatArc | None] = (None, None)  # evaluate the first / last piece when stretched
-
-    @cached_property
-    def _arrays(self) -> tuple[np.ndarray, list[list[list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]]]]:
-        """The shifts as an (orders × boundaries) array; per piece and component, per parity, the
-        frequencies, powers and an (orders × terms) coefficient matrix: a new ε costs small matrix products."""
-        shifts = np.array(self.shifts, dtype=float).reshape(len(self.shifts), -1)
-        pieces = []
-        for piece in range(len(self.terms[0])):
-            components = []
-            for component in range(len(self.terms[0][piece])):
-                groups = []
-                for parity in (0, 1):
-                    keys = sorted({(t[0], t[2]) for order in self.terms for t in order[piece][component] if t[1] == parity})
-                    if not keys:
-                        continue
-                    index = {key: position for position, key in enumerate(keys)}
-                    coefficients = np.zeros((len(self.terms), len(keys)))
-                    for n, order in enumerate(self.terms):
-                        for frequency, term_parity, power, value in order[piece][component]:
-                            if term_parity == parity:
-                                coefficients[n, index[frequency, power]] += value
-                    frequencies, powers = (np.array(column, dtype=float) for column in zip(*keys))
-                    groups.append((parity, frequencies, powers, coefficients))
-                components.append(groups)
-            pieces.append(components)
-        return shifts, pieces
-
-    def evaluate(self, strained_time: Any, scaled_epsilon: float, derivative: bool = False) -> np.ndarray:
-        """Σ_n ε̂^n W_n(s) (or d/ds of it) at the strained times s; shape ``s.shape + (N,)``."""
-        folded, sign = fold(np.asarray(strained_time, dtype=float))
-        shifts, pieces = self._arrays
-        weights = float(scaled_epsilon) ** np.arange(len(self.terms))
-        result = np.zeros(folded.shape + (len(pieces[0]),))
-        piece_index = np.searchsorted(weights @ shifts, folded) if len(pieces) > 1 else None
-        for piece, components in enumerate(pieces):
-            if piece_index is None:  # one piece (smooth f, or no contact): no masks
-                mask, points = ..., folded
-            else:
-                mask = piece_index == piece
-                if not np.any(mask):
-                    continue
-                points = folded[mask]
-            if piece == 0 and self.arcs[0] is not None:  # Y(s/s_1*)
-                length = weights @ shifts[:, 0]
-                values = self.arcs[0].evaluate(points / length, weights, derivative)
-                result[mask, 0] = values * sign[mask] / length if derivative else values
-                continue
-            if piece == len(pieces) - 1 and self.arcs[1] is not None:  # −Y((π − s)/(π − s_L*))
-                length = np.pi - weights @ shifts[:, -1]
-                values = self.arcs[1].evaluate((np.pi - points) / length, weights, derivative)
-                result[mask, 0] = values * sign[mask] / length if derivative else -values
-                continue
-            for component, groups in enumerate(components):
-                values = sum((_evaluate_terms(*group[:3], weights @ group[3], points, derivative) for group in groups), np.zeros(points.shape))
-                result[mask, component] = values * sign[mask] if derivative else values
-        return result
-
-
-def _evaluate_terms(parity: int, frequency: np.ndarray, power: np.ndarray, value: np.ndarray, s: np.ndarray, derivative: bool) -> np.ndarray:
-    """Σ value s^m trig(ν s) (trig = cos for parity 0, sin for 1), or its s-derivative, vectorised."""
-    argument = np.multiply.outer(s, frequency)
-    trig = np.cos(argument) if parity == 0 else np.sin(argument)
-    constant_power = not power.any()
-    powers = 1.0 if constant_power else np.power.outer(s, power)
-    if not derivative:
-        return (trig * powers) @ value
-    # d/ds s^m trig(νs) = m s^{m−1} trig(νs) + ν s^m trig'(νs),  cos' = −sin, sin' = cos
-    slope = (-np.sin(argument) if parity == 0 else np.cos(argument)) * frequency * powers
-    if not constant_power:
-        slope = slope + trig * np.where(power > 0, power * np.power.outer(s, np.maximum(power - 1, 0)), 0.0)
-    return slope @ value
-
-
 def _combination(domain: Any, branches: Sequence[Branch], weights: Sequence[Any]) -> Branch:
     """Σ_l weights[l] · branches[l], accumulated in one dictionary (a chain of Branch sums would copy O(N²) terms)."""
     terms: dict = {}
@@ -307,12 +223,6 @@ def _combination(domain: Any, branches: Sequence[Branch], weights: Sequence[Any]
             for key, value in branch.terms.items():
                 terms[key] = terms[key] + value * weight if key in terms else value * weight
     return Branch(domain, terms)
-
-
-def fold(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Reduce s to [0, π] using evenness and 2π-periodicity; also the sign of d/ds."""
-    shifted = np.mod(s + np.pi, 2 * np.pi) - np.pi
-    return np.abs(shifted), np.where(shifted < 0, -1.0, 1.0)
 
 
 class BranchHierarchy(LazyOrders):
@@ -355,7 +265,9 @@ class BranchHierarchy(LazyOrders):
                 continue
             boundary = system.boundaries[-which]  # the first boundary for the first piece, the last for the last
             length = boundary.point.value if which == 0 else system.pi_point.value - boundary.point.value
-            self._arc_data.append({"mu": [domain.one / (length * length)], "quotient": [-boundary.sine], "length": [length]})
+            self._arc_data.append({"mu": [domain.one / (length * length)], "quotient": [-boundary.sine], "length": [length],
+                                   "quotients": [[-boundary.sine if k == system.mode else domain.zero
+                                                  for k in range(system.size)]]})
         self._resonant = Branch(domain, {(1, 1, 1): domain.one / domain.convert(2)})  # s sin s / 2 solves v'' + v = cos s
         self._resonant_slope = self._resonant.derivative()
         # r_k as domain elements (the mode component's frequency is 1)
@@ -383,8 +295,11 @@ class BranchHierarchy(LazyOrders):
 
     @locked
     def release(self, order: int, component: int) -> Any:
-        """W_{order, component}(0)."""
-        return self.branches(order)[0][component].evaluate(self.system.zero_point)
+        """W_{order, component}(0) (on an N-dof first-piece arc: Y_{order, component}(0))."""
+        branches = self.branches(order)
+        if isinstance(self.system.arcs[0], VectorArc):
+            return self._domain.dtype(self.system.arcs[0].release(order, component))
+        return branches[0][component].evaluate(self.system.zero_point)
 
     @locked
     def arc_length(self, which: int, order: int) -> Any:
@@ -410,7 +325,8 @@ class BranchHierarchy(LazyOrders):
         )
         self._ensure(highest + self._lag)
         shifts = tuple(tuple(to_float(value) for value in self.boundary_shift(n)) for n in range(highest + 1))
-        arcs = tuple(None if arc is None else arc.float_arc(highest) for arc in self.system.arcs)
+        arcs = tuple(None if arc is None else arc.float_arcs(highest) if isinstance(arc, VectorArc)
+                     else arc.float_arc(highest) for arc in self.system.arcs)
         return FloatBranches(terms, shifts, arcs)
 
     def _law_power(self, piece: int, element: int, power: int, order: int) -> Branch:
@@ -527,8 +443,10 @@ class BranchHierarchy(LazyOrders):
         resonant = self._resonant
         top, bottom = system.arcs
         # A_n, then c_k on the first piece for every component k (σ_{1,n} with a first-piece arc),
-        # then h_n with a last-piece arc
-        unknown_count = size + 1 + (bottom is not None)
+        # then h_n with a last-piece arc; an N-dof first-piece arc (VectorArc): A_n, σ_{1,n}, the release
+        # values h_k (k ≠ j) and μ_n
+        vector = isinstance(top, VectorArc)
+        unknown_count = size + 1 + (bottom is not None) + vector
         turning = size + 1
 
         def constant(value: Any) -> _Affine:
@@ -541,7 +459,7 @@ class BranchHierarchy(LazyOrders):
         particular: list[list[Branch]] = []
         for piece, state in enumerate(system.states):
             if (piece == 0 and top is not None) or (piece == last_piece and bottom is not None):
-                particular.append([Branch(domain)])  # the stretched arc solves this piece itself
+                particular.append([Branch(domain)] * size)  # the stretched arc solves this piece itself
                 continue
             previous = self._branches[order - system.gauge][piece] if order >= system.gauge else None
             # L W = Σ g (c · W): the projections c · W_{n−1} once per piece (memoised: the components
@@ -595,6 +513,13 @@ class BranchHierarchy(LazyOrders):
             point = boundary.point
             powers = self._shift_powers(index, order)
             left, right = index, index + 1
+            if index == 0 and vector:
+                c_next, d_next, top_quotient, contact = self._match_first_vector_arc(
+                    order, point, boundary, powers, value_of, constant, unit)
+                c_values.append(c_next)
+                d_values.append(d_next)
+                shift_values.append(unit(1))
+                continue
             if index == 0 and top is not None:
                 c_next, d_next, top_quotient = self._match_first_arc(order, point, boundary, powers, value_of, constant, unit)
                 c_values.append(c_next)
@@ -651,6 +576,9 @@ class BranchHierarchy(LazyOrders):
             equations = [slope_condition, self._arc_frequency_condition(1, order, bottom_mu, shift_values[index].scale(-domain.one), unit)]
         if mode not in components:
             equations.append(unit(0).shift(-self._squared[order]))  # A_n is known: solved with the mode component
+        elif vector:  # the arc's end on its breakpoint, and A_n = [μ s_1*²]_n
+            equations.append(contact)
+            equations.append(self._arc_frequency_condition(0, order, unit(size + 1), unit(1), unit))
         elif top is not None:  # the release is the arc's; the unknowns are tied by A_n = [μ s_1*²]_n
             equations.append(self._arc_frequency_condition(0, order, constant(self._arc_data[0]["mu"][order]), unit(1), unit))
         elif self.normalization == "initial":
@@ -664,7 +592,7 @@ class BranchHierarchy(LazyOrders):
         branches = [[None] * system.size for _ in system.states] if coupled else self._branches[order]
         for piece in range(len(system.states)):
             if (piece == 0 and top is not None) or (piece == last_piece and bottom is not None):
-                branches[piece] = [Branch(domain)]  # the arc's own representation (StretchedArc) stands here
+                branches[piece] = [Branch(domain)] * system.size  # the arc's own representation stands here
                 continue
             for p, k in enumerate(components):
                 frequency = system.frequency(k)
@@ -688,7 +616,17 @@ class BranchHierarchy(LazyOrders):
         for shifts, value in zip(self._shifts, shift_values):
             if value is not None:
                 shifts.append(value.value(unknowns))
-        if top is not None:
+        if vector:
+            data = self._arc_data[0]
+            mu = unknowns[size + 1]
+            data["mu"].append(mu)
+            data["quotients"].append([q.value(unknowns) for q in top_quotient])
+            data["length"].append(unknowns[1])
+            release = system.release_at(order)
+            heights = [self._arc_height(k, unknowns, constant, unit).value(unknowns) if k != mode else
+                       (zero if release is None else release) for k in range(size)]
+            top.fix(order, heights, mu)
+        elif top is not None:
             self._arc_data[0]["quotient"].append(top_quotient.value(unknowns))
             self._arc_data[0]["length"].append(unknowns[1])
         if bottom is not None:
@@ -730,6 +668,54 @@ class BranchHierarchy(LazyOrders):
         x = value - value_of(1, 0, constant(domain.zero), constant(domain.zero), point, False)
         y = slope_target - value_of(1, 0, constant(domain.zero), constant(domain.zero), point, True)
         return [x.scale(cosine) - y.scale(sine)], [x.scale(sine) + y.scale(cosine)], quotient
+
+    def _arc_height(self, k: int, unknowns: Any, constant: Any, unit: Any) -> _Affine:
+        """The release value h_k (k ≠ j) of an N-dof first-piece arc among the order's unknowns."""
+        position = k if k < self.system.mode else k - 1
+        return unit(2 + position)
+
+    def _match_first_vector_arc(self, order: int, point: EvaluationPoint, boundary: MovingBoundary, powers: list,
+                                value_of: Any, constant: Any, unit: Any) -> tuple:
+        """:meth:`_match_first_arc` for N components (:class:`~lindstedt.engine.stretched.VectorArc`).
+
+        Unknowns: A_n (0), σ_n = ℓ_n (1), h_k = Y_{n,k}(0) for k ≠ j (2 …), μ_n (N + 1).  Every component's
+        end value ``Y_{n,k}(1)`` and slope ``Q_k = Y_k'(1)/s*`` are affine in them; the next piece matches
+        ``W_k(s*) = Y_k(1)`` and ``W_k'(s*) = Q_k`` (with W_0 = e_j cos s: −sin β σ_n and −cos β σ_n for k = j),
+        ``[Q_k]_n = (Y_{n,k}'(1) − Σ_{i=1}^{n−1} ℓ_i [Q_k]_{n−i} − ℓ_n [Q_k]_0)/β``; the contact condition is
+        ``χ · Y_n(1) = 0`` (the element's deformation is on its breakpoint at the arc's end).
+        """
+        domain, system, arc, data = self._domain, self.system, self.system.arcs[0], self._arc_data[0]
+        size, mode = system.size, system.mode
+        release = system.release_at(order)
+        ends = arc.response(order)
+        sine, cosine, beta = boundary.sine, point.cos_multiple(1), point.value
+        mu = unit(size + 1)
+        c_next, d_next, quotients = [], [], []
+        contact = constant(domain.zero)
+        for k in range(size):
+            end, end_slope = (domain.dtype(x) for x in ends[k])
+            dh_value, dh_slope, dmu_value, dmu_slope = (domain.dtype(x) for x in arc.end_terms(k))
+            height = constant(domain.zero if release is None else release) if k == mode else \
+                self._arc_height(k, None, constant, unit)
+            value = constant(end) + height.scale(dh_value) + mu.scale(dmu_value)
+            slope = constant(end_slope) + height.scale(dh_slope) + mu.scale(dmu_slope)
+            if boundary.coupling[k]:
+                contact = contact + value.scale(boundary.coupling[k])
+            known = sum((data["length"][i] * data["quotients"][order - i][k] for i in range(1, order)), domain.zero)
+            quotient = (slope.shift(-known) + unit(1).scale(-data["quotients"][0][k])).scale(domain.one / beta)
+            quotients.append(quotient)
+            target = value.shift(-self._known(0, 1, k, order, 0, powers))
+            slope_target = quotient.shift(-self._known(0, 1, k, order, 1, powers))
+            if k == mode:  # W_0'(β) σ_n = −sin β σ_n, W_0''(β) σ_n = −cos β σ_n move to the targets
+                target = target + unit(1).scale(sine)
+                slope_target = slope_target + unit(1).scale(cosine)
+            x = target - value_of(1, k, constant(domain.zero), constant(domain.zero), point, False)
+            y = slope_target - value_of(1, k, constant(domain.zero), constant(domain.zero), point, True)
+            frequency, ratio = system.frequency(k), self._ratio_elements[k]
+            cos_r, sin_r = point.cos_multiple(frequency), point.sin_multiple(frequency)
+            c_next.append(x.scale(cos_r) - y.scale(sin_r / ratio))
+            d_next.append(x.scale(sin_r) + y.scale(cos_r / ratio))
+        return c_next, d_next, quotients, contact
 
     def _match_last_arc(self, order: int, boundary: MovingBoundary, powers: list, shift: _Affine, left_slope: _Affine,
                         constant: Any, turning: _Affine) -> tuple:

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from fractions import Fraction
 from typing import Any
 
 import mpmath
@@ -42,6 +43,7 @@ from .._precision import locked
 from ..problems.system import UnilateralSystem
 from ..algebra.branch import EvaluationPoint
 from .branches import BranchHierarchy, BranchSystem, ContactState, MovingBoundary
+from .stretched import VectorArc
 
 __all__ = ["ModalNormalForm", "SpringAtOrderZero", "modal_guard_digits", "modal_normal_form"]
 
@@ -66,10 +68,12 @@ class SpringAtOrderZero:
 
 @dataclass(frozen=True)
 class _PiecewisePolynomial:
-    """An element's law as increasing breakpoints and one polynomial (coefficients by degree) per interval."""
+    """An element's law as increasing breakpoints and one polynomial (coefficients by degree) per interval, plus
+    its fractional terms ``c |u − point|^p`` (a Hertz contact) per interval."""
 
     breakpoints: tuple[Any, ...]
     pieces: tuple[tuple[Any, ...], ...]
+    fractional: tuple[tuple[tuple[Any, Any, Fraction], ...], ...] = ()
 
     def interval(self, deformation: Any) -> int:
         """Index of the interval holding a deformation (not on a breakpoint)."""
@@ -81,14 +85,19 @@ def _piecewise_polynomial(law: sympy.Expr, convert: Any) -> _PiecewisePolynomial
     from ..problems.piecewise_linear import decompose_piecewise, has_non_polynomial_law
     from ..problems.system import LAW_VARIABLE
 
-    if has_non_polynomial_law(law, LAW_VARIABLE):
+    intervals = decompose_piecewise(law, LAW_VARIABLE) if has_non_polynomial_law(law, LAW_VARIABLE) else None
+    if intervals is None:
+        intervals = decompose_piecewise(law, LAW_VARIABLE)
+    elif any(interval.analytic != 0 for interval in intervals):
         raise UnsupportedNonlinearityError(
-            f"the N-dof strained-coordinates NNM takes laws that are polynomial between breakpoints; {law} is not "
-            "(a fractional power or an analytic function of u): compute its NNMs by shooting (nnm_point, "
-            "continue_nnm), or expand the one-degree-of-freedom problem with lindstedt.expand")
-    intervals = decompose_piecewise(law, LAW_VARIABLE)
-    return _PiecewisePolynomial(tuple(convert(interval.upper) for interval in intervals[:-1]),
-                                tuple(tuple(convert(c) for c in interval.coefficients) for interval in intervals))
+            f"the N-dof strained-coordinates NNM takes laws polynomial between breakpoints, plus a fractional power "
+            f"of the distance to a breakpoint (Hertz); {law} has an analytic non-polynomial part: compute its NNMs "
+            "by shooting (nnm_point, continue_nnm), or expand the one-degree-of-freedom problem with lindstedt.expand")
+    return _PiecewisePolynomial(
+        tuple(convert(interval.upper) for interval in intervals[:-1]),
+        tuple(tuple(convert(c) for c in interval.coefficients) for interval in intervals),
+        tuple(tuple((convert(c), convert(point), Fraction(int(p.p), int(p.q))) for c, point, p in interval.fractional)
+              for interval in intervals))
 
 
 @dataclass(frozen=True)
@@ -241,8 +250,8 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
         if bottom:
             samples.append(samples[-1])
             flipped.append({s.index for s in bottom})
-        states = []
-        for middle, flips in zip(samples, flipped):
+        states, fractional = [], []
+        for piece, (middle, flips) in enumerate(zip(samples, flipped)):
             cosine = middle.context.cos(middle)
             load = [domain.zero] * size
             rank_one, elements = [], []
@@ -251,6 +260,8 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
                 for spring in springs:
                     if spring.index in flips and spring.element == i:  # across the grazed breakpoint
                         interval = spring.breakpoint + 1 if interval == spring.breakpoint else spring.breakpoint
+                if law.fractional and law.fractional[interval]:
+                    fractional.append((piece, i, interval))
                 constant, linear, powers = element_law(i, interval)
                 if constant:
                     for k in range(size):
@@ -261,6 +272,7 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
                 if powers:
                     elements.append((forcing_columns[i], coupling_vectors[i], powers))
             states.append(ContactState((), tuple(load), elements=tuple(elements), rank_one=tuple(rank_one)))
+        arc = _release_arc(fractional, states, crossing, boundaries, crossed) if fractional else None
         return BranchSystem(
             domain=domain,
             ratios=tuple(None if k == mode else ratio for k, ratio in enumerate(ratios)),
@@ -271,7 +283,33 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
             pi_point=pi_point,
             release=(convert(release_correction) * lam * lam / a0,),
             gauge=2 if crossed else 1,
+            arcs=(arc, None),
         )
+
+    def _release_arc(fractional: list, states: list, crossing: list, boundaries: list, crossed: dict) -> VectorArc:
+        """The first piece as a stretched arc: one element's fractional (Hertz) term in contact around the release
+        point, ending where that element's deformation reaches the term's breakpoint (the first boundary)."""
+        supported = ("the N-dof strained-coordinates NNM takes a fractional power law (Hertz) on one element whose "
+                     "contact holds the release point and ends at the first contact angle, without grazing")
+        piece, i, interval = fractional[0]
+        if len(fractional) != 1 or piece != 0 or crossed or not crossing or len(laws[i].fractional[interval]) != 1:
+            where = ("is in contact at the far turning point (release the mode on the other side, a0 → −a0, or"
+                     if piece != 0 else "is not (or not only) in contact around the release point (")
+            raise UnsupportedNonlinearityError(
+                f"{supported}; element {i + 1} ({system.laws[i]}) {where} compute its NNMs by shooting: nnm_point, "
+                "continue_nnm)")
+        c, point, exponent = laws[i].fractional[interval][0]
+        first = crossing[0]
+        if first.element != i or laws[i].breakpoints[first.breakpoint] != point:
+            raise UnsupportedNonlinearityError(
+                f"{supported}; another breakpoint is crossed inside element {i + 1}'s contact arc: compute its NNMs "
+                "by shooting (nnm_point, continue_nnm)")
+        chi = boundaries[0].coupling
+        coefficient = c * abs(chi[mode]) ** domain.convert(sympy.Rational(exponent.numerator, exponent.denominator)) / a0
+        state = states[0]
+        polynomial = (state.load, state.rank_one, state.elements)
+        return VectorArc([domain.one if k == mode else ratio for k, ratio in enumerate(ratios)], mode, chi,
+                         forcing_columns[i], first.kappa, exponent, coefficient, polynomial, digits)
 
     branch_system = assemble({})
     crossed = {}

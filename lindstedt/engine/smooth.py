@@ -58,7 +58,7 @@ from sympy import QQ, RealField
 from ..algebra.cosine import CosineSeries, solve_harmonic_oscillator, sum_of_products, sum_series
 from .._errors import UnsupportedNonlinearityError
 from ..problems.oscillator import DISPLACEMENT, Oscillator
-from .branches import FloatBranches
+from .float_branches import FloatBranches
 from .orders import LazyOrders
 from .._precision import locked, workdps
 

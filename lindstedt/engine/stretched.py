@@ -60,7 +60,7 @@ import sympy
 from .._errors import ConvergenceError, UnsupportedNonlinearityError
 from .._precision import locked, workdps
 
-__all__ = ["StretchedArc", "FloatArc"]
+__all__ = ["StretchedArc", "FloatArc", "VectorArc"]
 
 _INITIAL_NODES = 32
 _MAXIMUM_NODES = 1024
@@ -366,3 +366,276 @@ class StretchedArc:
         values = [zeroth_values] + [np.array([float(a) for a in series[0]]) for series in self._series[:highest]]
         slopes = [zeroth_slopes] + [np.array([float(a) for a in series[1]]) for series in self._series[:highest]]
         return FloatArc(self.denominator, values, slopes)
+
+
+class VectorArc:
+    """The release-side contact arc of an N-dof NNM with one fractional-power element (Hertz), on a fixed interval.
+
+    The modal normal form (:mod:`lindstedt.engine.modal`) on the first piece ``s ∈ [0, s*(ε̂))``, where element i
+    is in contact, in stretched time ``τ = s/s*``, ``Y_k(τ) = W_k(s* τ)``, ``μ = Ω²/s*²``::
+
+        μ Y_k'' + r_k² Y_k + ε̂ F_k(Y) = 0,    Y_k'(0) = 0,    χ·Y(1) = κ χ_j (the contact point stays at τ = 1),
+
+    ``F_k = g_k ĉ z^p + (the other elements' polynomial pieces on this state)``, ``z = (χ·Y)/χ_j − κ`` the
+    element's normalised deformation past its breakpoint, ``χ = a0 B_i`` its coupling, ``g = G_i`` its force
+    direction.  ``Y_0 = e_j cos βτ``, ``μ_0 = 1/β²``; order n reads, component by component,
+
+        Y_{n,k}'' + β² r_k² Y_{n,k} = −β² (Σ_{i=1}^{n} μ_i Y_{n−i,k}'' + [F_k]_{n−1}),
+
+    solved by variation of parameters from τ = 0: ``Y_{n,k} = h_k cos(β r_k τ) + P_k(τ)`` plus, for k = j, the
+    resonant ``(β³ μ_n/2) τ sin βτ``.  The fractional factor keeps a fixed weight,
+    ``z^p = (cos βτ − cos β)^p (1 + Σ R_m ε̂^m)^p``, ``R_m = (χ·Y_m)/(χ_j (cos βτ − cos β))`` (bounded: the contact
+    condition makes χ·Y_m(1) = 0), as for one degree of freedom (:class:`StretchedArc`, the N = 1 case, which
+    this arc reduces to).  The unknowns of an order — the release values ``h_k`` (k ≠ j; ``h_j`` is prescribed)
+    and ``μ_n`` — are fixed by the branch hierarchy with the matching at the arc's end; :meth:`response` gives
+    the arc's end values and slopes without them, :meth:`fix` completes the order.
+
+    Representation as for :class:`StretchedArc`: values at Chebyshev points in ``v = (1 − τ)^{1/d}``, cumulative
+    Chebyshev integrals, the grid doubled until every component's tail is below the working precision.
+    """
+
+    def __init__(self, ratios: Sequence[Any], mode: int, coupling: Sequence[Any], forcing: Sequence[Any],
+                 kappa: Any, exponent: Fraction, coefficient: Any, polynomial: Any, digits: int):
+        if exponent <= 0 or exponent.denominator == 1:
+            raise ValueError("the stretched arc's power law needs a non-integer exponent p > 0")
+        self.exponent = exponent
+        self.denominator = exponent.denominator
+        self.digits = digits
+        self.mode = mode
+        self._working = digits + _GUARD_DIGITS
+        with workdps(self._working):
+            self.ratios = [mpmath.mpf(r) for r in ratios]
+            self.coupling = [mpmath.mpf(c) for c in coupling]
+            self.forcing = [mpmath.mpf(g) for g in forcing]
+            self.kappa = mpmath.mpf(kappa)
+            self.coefficient = mpmath.mpf(coefficient)
+            self.beta = mpmath.acos(self.kappa)
+            load, rank_one, elements = polynomial
+            self._load = [mpmath.mpf(x) for x in load]
+            self._rank_one = [([mpmath.mpf(x) for x in g], [mpmath.mpf(x) for x in c]) for g, c in rank_one]
+            self._elements = [([mpmath.mpf(x) for x in g], [mpmath.mpf(x) for x in c],
+                               [(m, mpmath.mpf(value)) for m, value in powers]) for g, c, powers in elements]
+        self.size = len(self.ratios)
+        self._fixed: list[tuple[list[Any], Any]] = []  # (h_k, μ_n) of orders 1, 2, …
+        self._pending: tuple[int, list[dict]] | None = None
+        self.nodes = _INITIAL_NODES
+        self._reset()
+        self.counters = {"orders": 0, "restarts": 0}
+
+    def _reset(self) -> None:
+        M, d, beta = self.nodes, self.denominator, None
+        with workdps(self._working):
+            beta = self.beta
+            angles = [mpmath.pi * (i + mpmath.mpf(1) / 2) / M for i in range(M)]
+            self._v = [(mpmath.cos(angle) + 1) / 2 for angle in angles]
+            self._tau = [1 - v**d for v in self._v]
+            self._trig = [([mpmath.cos(beta * r * t) for t in self._tau], [mpmath.sin(beta * r * t) for t in self._tau])
+                          for r in self.ratios]
+            # cos βτ − cos β = 2 sin(β(1 + τ)/2) sin(β v^d/2), without cancellation near τ = 1
+            self._gap = [2 * mpmath.sin(beta * (1 + t) / 2) * mpmath.sin(beta * v**d / 2) for t, v in zip(self._tau, self._v)]
+            self._weight = [self.coefficient * g**self.exponent for g in self._gap]
+            self._jacobian = [d * v ** (d - 1) for v in self._v]
+            self._transform = [[mpmath.cos(k * angle) for angle in angles] for k in range(M)]
+            zero = [mpmath.mpf(0)] * M
+            cosine = self._trig[self.mode][0]
+            self._values = [[list(cosine) if k == self.mode else list(zero) for k in range(self.size)]]
+            self._second = [[[-beta * beta * c for c in cosine] if k == self.mode else list(zero) for k in range(self.size)]]
+            self._ratios_r: list[list[Any]] = [[]]
+            self._binomial = [[mpmath.mpf(1)] * M]
+            self._mu = [1 / (beta * beta)]
+            self._powers: dict[tuple[int, int, int], list[Any]] = {}
+            self._series: list[list[tuple[list[Any], list[Any]]]] = []
+            self.tail = mpmath.mpf(0)
+
+    _coefficients = StretchedArc._coefficients
+    _integral_to_end = StretchedArc._integral_to_end
+
+    def _projection(self, vector: Sequence[Any], order: int) -> list[Any]:
+        """vector · Y_order at the nodes."""
+        values = self._values[order]
+        return [mpmath.fsum(w * values[k][i] for k, w in enumerate(vector) if w) for i in range(self.nodes)]
+
+    def _power(self, element: int, power: int, order: int) -> list[Any]:
+        """[(c_e · Y)^power]_order at the nodes."""
+        key = (element, power, order)
+        if key not in self._powers:
+            coupling = self._elements[element][1]
+            if power == 1:
+                result = self._projection(coupling, order)
+            else:
+                result = [mpmath.mpf(0)] * self.nodes
+                for i in range(order + 1):
+                    left, right = self._power(element, power - 1, i), self._power(element, 1, order - i)
+                    result = [r + x * y for r, x, y in zip(result, left, right)]
+            self._powers[key] = result
+        return self._powers[key]
+
+    def _law(self, order: int, k: int) -> list[Any]:
+        """[F_k(Y)]_order at the nodes."""
+        M = self.nodes
+        total = [self.forcing[k] * self._weight[i] * self._binomial[order][i] for i in range(M)] if self.forcing[k] \
+            else [mpmath.mpf(0)] * M
+        if order == 0 and self._load[k]:
+            total = [t + self._load[k] for t in total]
+        for g, c in self._rank_one:
+            if g[k]:
+                projection = self._projection(c, order)
+                total = [t + g[k] * y for t, y in zip(total, projection)]
+        for element, (g, _, powers) in enumerate(self._elements):
+            if g[k]:
+                for power, value in powers:
+                    term = self._power(element, power, order)
+                    total = [t + g[k] * value * y for t, y in zip(total, term)]
+        return total
+
+    def _particular(self, order: int) -> list[dict]:
+        """Per component: the forcing without μ_order, P_k at the nodes and P_k(1), P_k'(1)."""
+        beta = self.beta
+        out = []
+        for k in range(self.size):
+            law = self._law(order - 1, k)
+            forcing = [-beta * beta * value for value in law]
+            for i in range(1, order):
+                mu = self._mu[i]
+                forcing = [g - beta * beta * mu * y for g, y in zip(forcing, self._second[order - i][k])]
+            cosine, sine = self._trig[k]
+            integrand_cos = [j * c * g for j, c, g in zip(self._jacobian, cosine, forcing)]
+            integrand_sin = [j * s * g for j, s, g in zip(self._jacobian, sine, forcing)]
+            cos_integral, cos_total = self._integral_to_end(integrand_cos)
+            sin_integral, sin_total = self._integral_to_end(integrand_sin)
+            omega = beta * self.ratios[k]
+            end_cos, end_sin = mpmath.cos(omega), mpmath.sin(omega)
+            coefficients = self._coefficients(integrand_cos)
+            scale = max(abs(a) for a in coefficients) or mpmath.mpf(1)
+            out.append({
+                "forcing": forcing, "cos": cos_integral, "sin": sin_integral,
+                "end": (end_sin * cos_total - end_cos * sin_total) / omega,
+                "end_slope": end_cos * cos_total + end_sin * sin_total,
+                "tail": max(abs(a) for a in coefficients[-4:]) / scale,
+            })
+        return out
+
+    def _solve(self, order: int, release: list[Any], mu: Any, data: list[dict]) -> None:
+        beta = self.beta
+        resonant = beta**3 / 2
+        values_all, second_all, series = [], [], []
+        for k in range(self.size):
+            cosine, sine = self._trig[k]
+            omega = beta * self.ratios[k]
+            item = data[k]
+            values, slopes, second = [], [], []
+            for i in range(self.nodes):
+                c, s, t = cosine[i], sine[i], self._tau[i]
+                value = release[k] * c + (s * item["cos"][i] - c * item["sin"][i]) / omega
+                slope = -release[k] * omega * s + c * item["cos"][i] + s * item["sin"][i]
+                force = item["forcing"][i]
+                if k == self.mode:
+                    value += resonant * mu * t * s
+                    slope += resonant * mu * (s + beta * t * c)
+                    force += beta**4 * mu * c
+                values.append(value)
+                slopes.append(slope)
+                second.append(force - omega * omega * value)
+            values_all.append(values)
+            second_all.append(second)
+            value_series = self._coefficients(values)
+            series.append((value_series, self._coefficients(slopes)))
+            size = max(abs(a) for a in value_series)
+            if size:
+                self.tail = max(self.tail, max(abs(a) for a in value_series[-4:]) / size)
+        self._values.append(values_all)
+        self._second.append(second_all)
+        p = mpmath.mpf(self.exponent.numerator) / self.exponent.denominator
+        chi_j = self.coupling[self.mode]
+        deformation = self._projection(self.coupling, order)
+        self._ratios_r.append([z / (chi_j * g) for z, g in zip(deformation, self._gap)])
+        # B_n = (1/n) Σ_{k=1}^{n} ((p + 1) k − n) R_k B_{n−k}   (powers of 1 + Σ R_k ε̂^k)
+        self._binomial.append([mpmath.fsum(((p + 1) * k - order) * self._ratios_r[k][i] * self._binomial[order - k][i]
+                                           for k in range(1, order + 1)) / order for i in range(self.nodes)])
+        self._mu.append(mu)
+        self._series.append(series)
+
+    def _refine(self, order: int) -> None:
+        if 2 * self.nodes > _MAXIMUM_NODES:
+            raise ConvergenceError(
+                f"the stretched contact arc needs more than {_MAXIMUM_NODES} Chebyshev points "
+                f"for {self.digits} digits at order {order} (tail {mpmath.nstr(self.tail, 3)}); "
+                "ask for fewer digits or a lower order")
+        self.nodes *= 2
+        self.counters["restarts"] += 1
+        self._reset()
+        for n, (release, mu) in enumerate(self._fixed, start=1):
+            with workdps(self._working):
+                self._solve(n, release, mu, self._particular(n))
+
+    @locked
+    def response(self, order: int) -> list[tuple[Any, Any]]:
+        """Per component, ``(P_k(1), P_k'(1))``: the end value and slope of Y_{order,k} without its unknowns.
+
+        The whole end value is ``P_k(1) + h_k cos(β r_k) [+ (β³ μ/2) sin β for k = j]``, the slope
+        ``P_k'(1) − h_k β r_k sin(β r_k) [+ (β³ μ/2)(sin β + β cos β)]`` (:meth:`end_terms`).
+        """
+        if order != len(self._mu):
+            raise ValueError(f"order {order} of the stretched arc is not the next one ({len(self._mu)})")
+        tolerance = mpmath.mpf(10) ** (-(self.digits + 2))
+        while True:
+            with workdps(self._working):
+                data = self._particular(order)
+            if max(max(item["tail"] for item in data), self.tail) <= tolerance:
+                break
+            self._refine(order)
+        self._pending = (order, data)
+        return [(item["end"], item["end_slope"]) for item in data]
+
+    @locked
+    def end_terms(self, k: int) -> tuple[Any, Any, Any, Any]:
+        """(∂Y_k(1)/∂h_k, ∂Y_k'(1)/∂h_k, ∂Y_k(1)/∂μ, ∂Y_k'(1)/∂μ) of one order (the same at every order)."""
+        with workdps(self._working):
+            beta, omega = self.beta, self.beta * self.ratios[k]
+            resonant = beta**3 / 2
+            mu_value = resonant * mpmath.sin(beta) if k == self.mode else mpmath.mpf(0)
+            mu_slope = resonant * (mpmath.sin(beta) + beta * mpmath.cos(beta)) if k == self.mode else mpmath.mpf(0)
+            return mpmath.cos(omega), -omega * mpmath.sin(omega), mu_value, mu_slope
+
+    @locked
+    def fix(self, order: int, release: Sequence[Any], mu: Any) -> None:
+        """Complete Y_order with its release values h_k = Y_{order,k}(0) and μ_order."""
+        if self._pending is None or self._pending[0] != order:
+            self.response(order)
+        with workdps(self._working):
+            release = [mpmath.mpf(h) for h in release]
+            mu = mpmath.mpf(mu)
+            self._solve(order, release, mu, self._pending[1])
+        self._fixed.append((release, mu))
+        self._pending = None
+        self.counters["orders"] += 1
+
+    @locked
+    def mu(self, order: int) -> Any:
+        """μ_order (fixed orders only)."""
+        return self._mu[order]
+
+    @locked
+    def release(self, order: int, component: int) -> Any:
+        """Y_{order, component}(0) (fixed orders only)."""
+        return mpmath.mpf(1 if component == self.mode else 0) if order == 0 else self._fixed[order - 1][0][component]
+
+    @locked
+    def float_arcs(self, highest: int) -> tuple[FloatArc, ...]:
+        """One float evaluator per component of Y_0 … Y_highest."""
+        if len(self._mu) <= highest:
+            raise ValueError(f"order {highest} of the stretched arc is not fixed yet")
+        arcs = []
+        with workdps(self._working):
+            for k in range(self.size):
+                cosine, sine = self._trig[k]
+                omega = self.beta * self.ratios[k]
+                zeroth = ([c if k == self.mode else mpmath.mpf(0) for c in cosine],
+                          [-omega * s if k == self.mode else mpmath.mpf(0) for s in sine])
+                values = [np.array([float(a) for a in self._coefficients(zeroth[0])])]
+                slopes = [np.array([float(a) for a in self._coefficients(zeroth[1])])]
+                for series in self._series[:highest]:
+                    values.append(np.array([float(a) for a in series[k][0]]))
+                    slopes.append(np.array([float(a) for a in series[k][1]]))
+                arcs.append(FloatArc(self.denominator, values, slopes))
+        return tuple(arcs)

@@ -19,7 +19,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from ..compiled.stable_source import stable_function
-from ..engine.branches import FloatBranches
+from ..engine.float_branches import FloatBranches
 from ._values import Point, finite, floats, omega_expr, substitution, to_float
 from ._waveform_data import _WAVEFORM_TOLERANCE, _WaveformData, _WaveformLayout
 

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import sympy
 
-from ..engine.branches import FloatBranches
+from ..engine.float_branches import FloatBranches
 from ..compiled.family import compile_family
 
 _WAVEFORM_TOLERANCE = 1e-13  # bound on |δu| / |a0| accepted from compiled waveform data

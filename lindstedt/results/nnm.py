@@ -19,7 +19,8 @@ import sympy
 
 from ..render.json import finite_float
 from ..render.display import DIGITS, format_number, format_vector, jupyter_latex, labelled_repr
-from ..engine.branches import BranchHierarchy, FloatBranches, fold
+from ..engine.branches import BranchHierarchy
+from ..engine.float_branches import FloatBranches, fold
 from .accuracy import (
     ExpansionValidityWarning,
     branch_bound,
@@ -278,9 +279,11 @@ class NNMExpansion:
         return self._hierarchy.float_branches(max(self.gauge * self.order - 1, 0))
 
     @cached_property
-    def _compiled(self) -> "_CompiledWaveform":
-        """W_0 … W_{N−1} compiled for evaluation over every component at once (built once)."""
-        return _CompiledWaveform(self._float_branches)
+    def _compiled(self) -> "_CompiledWaveform | FloatBranches":
+        """W_0 … W_{N−1} compiled for evaluation over every component at once (built once); with a stretched
+        contact arc (a Hertz element) the float branches themselves, which evaluate the arc in stretched time."""
+        branches = self._float_branches
+        return branches if branches.arcs != (None, None) else _CompiledWaveform(branches)
 
     def displacement(self, t: Any, epsilon: float) -> np.ndarray:
         """Physical X(t) = Φ U(t) of :meth:`modal_displacement` (shape ``t.shape + (N_dof,)``).
@@ -408,14 +411,14 @@ class _CompiledWaveform:
     frequencies ν among them, and per order a sparse (terms × components) coefficient matrix.  An
     evaluation forms cos/sin of the distinct frequencies at the points of each piece once and multiplies
     by the ε̂-weighted sum of the sparse matrices: O(points × terms + nonzeros), no Python loop over
-    components.  (The NNM's branches have no stretched arcs.)
+    components.  (A stretched arc is evaluated by :class:`FloatBranches` instead.)
     """
 
     def __init__(self, branches: FloatBranches):
         import scipy.sparse  # here, not at module level: import lindstedt stays light
 
         if branches.arcs != (None, None):
-            raise ValueError("stretched arcs are evaluated by FloatBranches")  # pragma: no cover - not in an NNM
+            raise ValueError("stretched arcs are evaluated by FloatBranches")  # pragma: no cover - _compiled routes them
         self.shifts = np.array(branches.shifts, dtype=float).reshape(len(branches.shifts), -1)
         self.orders = len(branches.terms)
         self.size = len(branches.terms[0][0])
