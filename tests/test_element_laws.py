@@ -145,3 +145,32 @@ def test_energy_and_acceleration_of_any_law_along_the_ode():
     # conserved up to the integrator's error: the drift falls with its tolerance (3e-8 → 5e-10 measured); a wrong
     # potential would leave an O(1) drift that no tolerance reduces
     assert drifts[0] < 1e-6 and drifts[1] < drifts[0] / 10
+
+
+def test_a_system_file_may_list_its_elements():
+    data = {"M": [[1, 0], [0, 2]], "K": [[3, -1], [-1, 2]],
+            "elements": [{"law": "u**3", "a": [1, -1], "w": [2, -2]}, {"a": [0, 1], "b": "1/10"},
+                         {"law": "Max(0, u)**(3/2)", "a": [1, 0], "b": "-1/5"}]}
+    system = UnilateralSystem.from_json_dict(data)
+    expected = UnilateralSystem(M=[[1, 0], [0, 2]], K=[[3, -1], [-1, 2]], A=[[1, -1], [0, 1], [1, 0]],
+                                b=[0, "1/10", "-1/5"], W=[[2, 0, 1], [-2, 1, 0]],
+                                laws=["u**3", "Max(0, u)", "Max(0, u)**(3/2)"])
+    assert system == expected
+    assert UnilateralSystem.from_json_dict(system.to_json_dict()) == system  # written back with A, b, W, laws
+
+
+@pytest.mark.parametrize(("elements", "words"), [
+    ([{"law": "u**3"}], r"at least 'a'"),
+    ([{"a": [1, 0], "k": 2}], r"unknown keys \['k'\]"),
+    ([{"a": [1, 0], "w": [1, 0, 0]}], r"W must be N×m"),
+    ({"a": [1, 0]}, r"must be a list"),
+    ([{"a": [0, 0]}], r"row 0 of A is zero"),
+])
+def test_bad_element_lists_are_typed_errors(elements, words):
+    with pytest.raises(lindstedt.ProblemError, match=words):
+        UnilateralSystem.from_json_dict({"M": [[1, 0], [0, 1]], "K": [[2, -1], [-1, 2]], "elements": elements})
+
+
+def test_elements_and_matrices_together_are_refused():
+    with pytest.raises(lindstedt.ProblemError, match=r"both elements and \['A'\]"):
+        UnilateralSystem.from_json_dict({"M": [[1]], "K": [[1]], "A": [[1]], "elements": [{"a": [1]}]})

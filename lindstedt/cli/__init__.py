@@ -136,8 +136,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     nnm = commands.add_parser("nnm", help="nonlinear normal mode of M X'' + K X + eps W f(A X - b) = 0 by strained "
                                           "coordinates (unilateral springs) or by shooting (--numeric, any law)")
-    nnm.add_argument("system", help="SYSTEM.json with keys M, K, A and optional b (default 0), W and laws (nested lists, "
-                                         "numbers or exact strings; laws: one f(u) per row of A, default Max(0, u))")
+    nnm.add_argument("system", help="SYSTEM.json with keys M, K, A and optional b (default 0), W, laws and couplings "
+                                         "(nested lists, numbers or exact strings; laws: one f(u) per row of A, default "
+                                         "Max(0, u)), or M, K and elements: [{law, a, b, w}, ...]")
     nnm.add_argument("--mode", type=int, required=True, help="mode number j (1-based, increasing frequency)")
     nnm.add_argument("--a0", default=None, help="modal amplitude of mode j at release (expansion, or --numeric with the other modal coordinates free)")
     nnm.add_argument("--numeric", action="store_true", help="periodic orbit by shooting instead of the expansion (on the exact flow for "

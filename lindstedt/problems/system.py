@@ -40,7 +40,8 @@ from .parsing import parse_expression
 
 __all__ = ["UnilateralSystem", "Modes", "OneDofUnilateral"]
 
-_JSON_KEYS = ("M", "K", "A", "b", "W", "laws", "couplings")
+_JSON_KEYS = ("M", "K", "A", "b", "W", "laws", "couplings", "elements")
+_ELEMENT_KEYS = ("law", "a", "b", "w")
 #: the variable of an element's law f(u) (the oscillator's u)
 LAW_VARIABLE = sympy.Symbol("u", real=True)
 #: the law of a unilateral spring, the default of every element
@@ -423,7 +424,10 @@ class UnilateralSystem:
 
     @classmethod
     def from_json_dict(cls, data: Mapping[str, Any]) -> "UnilateralSystem":
-        """Build from a mapping with keys ``M``, ``K``, ``A`` and optional ``b`` (default zeros), ``W`` and ``laws``.
+        """Build from a mapping with keys ``M``, ``K``, ``A`` and optional ``b`` (default zeros), ``W``, ``laws`` and
+        ``couplings`` — or, instead of ``A``, ``b``, ``W``, ``laws``, a list ``elements`` of
+        ``{"law": f, "a": row, "b": offset, "w": column}`` (``law`` default ``Max(0, u)``, ``b`` default 0, ``w``
+        default ``a``): the element's force ``ε w f(aᵀX − b)``.
 
         Entries may be numbers or exact strings (as written by :meth:`to_json_dict`).
 
@@ -432,17 +436,29 @@ class UnilateralSystem:
         >>> data = {"M": [["1"]], "K": [["4"]], "A": [["1"]], "b": ["1/3"]}
         >>> UnilateralSystem.from_json_dict(data).b_exact[0]
         1/3
+        >>> chain = {"M": [[1, 0], [0, 1]], "K": [[2, -1], [-1, 2]],
+        ...          "elements": [{"law": "u**3", "a": [1, -1]}, {"a": [0, 1], "b": "1/10"}]}
+        >>> system = UnilateralSystem.from_json_dict(chain)
+        >>> system.laws, system.A.tolist(), system.b.tolist()
+        ((u**3, Max(0, u)), [[1.0, -1.0], [0.0, 1.0]], [0.0, 0.1])
         """
         if not isinstance(data, Mapping):
             raise ProblemError(f"from_json_dict expects a mapping with keys M, K, A, b (and optionally W), got {type(data).__name__}")
         unknown = sorted(set(data) - set(_JSON_KEYS))
         if unknown:
             raise ProblemError(f"unknown keys {unknown} in the system definition; the keys are M, K, A, b and optional W, "
-                               "laws and couplings")
+                               "laws and couplings (or elements instead of A, b, W, laws)")
+        if "elements" in data:
+            clash = sorted(key for key in ("A", "b", "W", "laws") if key in data)
+            if clash:
+                raise ProblemError(f"the system definition gives both elements and {clash}: write every element in "
+                                   "'elements' ({law, a, b, w}) or use the keys A, b, W, laws — not both")
+            data = {**{key: value for key, value in data.items() if key != "elements"},
+                    **_elements_as_matrices(data["elements"])}
         missing = [key for key in ("M", "K", "A") if key not in data]
         if missing:
-            raise ProblemError(f"the system definition lacks the keys {missing}; give M, K, A and b (A = [] for none; "
-                               "b may be omitted when every offset is 0)")
+            raise ProblemError(f"the system definition lacks the keys {missing}; give M, K and A (A = [] for none) or "
+                               "elements, and b (may be omitted when every offset is 0)")
         return cls(M=data["M"], K=data["K"], A=data["A"], b=data.get("b"), W=data.get("W"), laws=data.get("laws"),
                    couplings=data.get("couplings"))
 
@@ -645,6 +661,33 @@ class UnilateralSystem:
         contact = epsilon * np.sum(self._element_potentials(self.gaps(positions)), axis=-1)
         total = kinetic + potential + contact
         return float(total) if np.ndim(total) == 0 else total
+
+
+def _elements_as_matrices(elements: Any) -> dict[str, Any]:
+    """A, b, W, laws from a JSON list of elements ``{law, a, b, w}`` (shapes checked by the constructor)."""
+    if not isinstance(elements, (list, tuple)):
+        raise ProblemError(f"elements must be a list of {{law, a, b, w}} objects, got {type(elements).__name__}")
+    rows, offsets, columns, laws = [], [], [], []
+    for index, element in enumerate(elements):
+        if not isinstance(element, Mapping) or "a" not in element:
+            raise ProblemError(f"elements[{index}] must be an object with at least 'a' (the row a of aᵀX) and "
+                               f"optional law, b, w; got {element!r}")
+        unknown = sorted(set(element) - set(_ELEMENT_KEYS))
+        if unknown:
+            raise ProblemError(f"elements[{index}] has unknown keys {unknown}; the keys are law, a, b, w")
+        rows.append(element["a"])
+        offsets.append(element.get("b", 0))
+        columns.append(element.get("w", element["a"]))
+        laws.append(element.get("law", "Max(0, u)"))
+    if not rows:
+        return {"A": [], "b": []}
+    if any(not isinstance(column, (list, tuple)) for column in columns):
+        raise ProblemError("every element's a and w must be lists with one entry per degree of freedom")
+    width = len(columns[0])
+    if any(len(column) != width for column in columns):
+        raise ProblemError("every element's w must have one entry per degree of freedom (the size of M)")
+    W = [[column[i] for column in columns] for i in range(width)]
+    return {"A": rows, "b": offsets, "W": W, "laws": laws}
 
 
 @locked
