@@ -1,5 +1,5 @@
-"""Strained-coordinates NNMs of systems whose elements carry any law polynomial between breakpoints, or a Hertz
-contact (issue 25, item 2).
+"""Strained-coordinates NNMs of systems whose elements carry any law polynomial between breakpoints, a Hertz
+contact, or an analytic law (issue 25, item 2).
 
 ``M X'' + K X + ε Σ_i w_i f_i(a_iᵀ X − b_i) = 0``: the one branch hierarchy with, on every contact state, each
 element's polynomial piece acting on its deformation (a cubic spring between two masses, a contact piece
@@ -37,6 +37,9 @@ from lindstedt.numerics import nnm_point
     ("u*Abs(u)", 1, "1", 1),                    # odd piecewise polynomial
     ("u**3 + 2*Max(0, u)", 2, "3/4", 1),        # polynomial plus a spring
     ("Max(0, u + 1)", 1, "1", 2),               # grazing: the orbit passes the breakpoint, gauge ε^(1/2)
+    ("sin(u)", 1, "1/2", 1),                    # analytic
+    ("u**3 + sin(u)", 1, "1/2", 1),             # analytic plus polynomial
+    ("1/(2 - u)", 1, "1", 1),                   # analytic with a pole off the orbit
 ])
 def test_nnm_at_one_degree_of_freedom_is_the_oscillator_expansion(law, omega_squared, a0, gauge):
     order = 4
@@ -79,6 +82,8 @@ ELEMENTS = {
     "jump at a dof": ([[0, 1]], ["1/10"], ["Heaviside(u)"]),
     "gap on the relative displacement": ([[1, -1]], ["1/10"], ["Max(0, u)"]),
     "gap and cubic spring": ([[1, -1], [1, 0]], ["1/10", 0], ["Max(0, u)", "u**3"]),
+    "analytic law between the masses": ([[1, -1]], [0], ["sin(u)"]),
+    "gap and analytic law": ([[1, 0], [1, -1]], ["1/5", 0], ["Max(0, u)", "sin(u) - u"]),
 }
 
 
@@ -147,9 +152,9 @@ def test_the_first_order_shift_of_a_cubic_coupling_is_its_modal_average():
         assert float(lindstedt.nnm(system, mode, a0=1, order=1).omega[1]) == pytest.approx(expected, rel=1e-13)
 
 
-def test_a_law_that_is_not_polynomial_between_breakpoints_names_shooting():
-    system = UnilateralSystem(M=M, K=K, A=[[1, 0]], laws=["sin(u)"])
-    with pytest.raises(UnsupportedNonlinearityError, match=r"sin\(u\).*analytic.*nnm_point"):
+def test_an_analytic_law_whose_element_crosses_a_breakpoint_names_shooting():
+    system = UnilateralSystem(M=M, K=K, A=[[1, 0]], laws=["Max(0, u)*exp(u)"])
+    with pytest.raises(UnsupportedNonlinearityError, match=r"analytic law.*crosses one.*nnm_point"):
         lindstedt.nnm(system, 1, a0=1)
 
 

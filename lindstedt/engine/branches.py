@@ -56,12 +56,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Sequence
 
-import mpmath
 
-from .._errors import ResonanceError
 from ..algebra.branch import Branch, EvaluationPoint
 from .._precision import locked
 from .orders import LazyOrders, shift_powers
+from .affine import _Affine, solve_linear
 from .float_branches import FloatBranches
 from .stretched import VectorArc
 
@@ -79,12 +78,16 @@ class ContactState:
     ``elements`` lists ``(g, c, ((m, c_m), …))``, m ≥ 2: the higher powers of a polynomial law acting on
     the deformation ``c · W`` with the force direction g — the 1-dof oscillator's piecewise-polynomial f is
     ``((1,), (1,), …)``, an N-dof element's ``(G_i, B_i, …)``.
+    ``analytic`` lists ``(g, c, law)``: an analytic law of the deformation ``y = c · W`` expanded about its
+    order-zero value, ``Σ_m law.branch(m) [(y − y_0)^m]_n`` (``law.branch(m)``: the cosine series of its m-th Taylor
+    coefficient along ``y_0(s)``).
     """
 
     stiffness: tuple[tuple[Any, ...], ...]
     load: tuple[Any, ...]
     elements: tuple[tuple[tuple[Any, ...], tuple[Any, ...], tuple[tuple[int, Any], ...]], ...] = ()
     rank_one: tuple[tuple[tuple[Any, ...], tuple[Any, ...]], ...] = ()
+    analytic: tuple[tuple[tuple[Any, ...], tuple[Any, ...], Any], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -149,72 +152,6 @@ class BranchSystem:
         return 1 if ratio is None else ratio
 
 
-class _Affine:
-    """A value of order n, affine in the unknowns (A_n, c_1 … c_N): base + Σ coefficient·unknown."""
-
-    __slots__ = ("base", "coefficients")
-
-    def __init__(self, base: Any, coefficients: list[Any]):
-        self.base = base
-        self.coefficients = coefficients
-
-    def __add__(self, other: "_Affine") -> "_Affine":
-        return _Affine(self.base + other.base, [a + b for a, b in zip(self.coefficients, other.coefficients)])
-
-    def __sub__(self, other: "_Affine") -> "_Affine":
-        return _Affine(self.base - other.base, [a - b for a, b in zip(self.coefficients, other.coefficients)])
-
-    def scale(self, factor: Any) -> "_Affine":
-        return _Affine(self.base * factor, [a * factor for a in self.coefficients])
-
-    def shift(self, constant: Any) -> "_Affine":
-        return _Affine(self.base + constant, list(self.coefficients))
-
-    def value(self, unknowns: Sequence[Any]) -> Any:
-        total = self.base
-        for coefficient, unknown in zip(self.coefficients, unknowns):
-            total = total + coefficient * unknown
-        return total
-
-
-def solve_linear(matrix: list[list[Any]], vector: list[Any], domain: Any, order: int) -> list[Any]:
-    """Gaussian elimination in ``domain``: partial pivoting for floats, first nonzero pivot when exact.
-
-    Kept because measured (40 digits, random systems of the package's sizes N + 1 = 3, 6, 21):
-    61 µs, 0.94 ms, 10 ms here against 5.7, 5.6 and 26 ms for ``mpmath.lu_solve`` with the
-    conversions to and from mpf matrices (whose naive round trip through ``RealField.convert``
-    also fell to 1e-16); exact 2 × 2 over ``QQ(p, k)``: 1.5 ms here, 1.4 ms ``DomainMatrix.lu_solve``
-    (which does not pivot for size, so it cannot serve the float case).
-    """
-    size = len(vector)
-    rows = [row[:] + [value] for row, value in zip(matrix, vector)]
-    exact = domain.is_Exact
-    threshold = None
-    if not exact:
-        scale = max((abs(entry) for row in matrix for entry in row), default=domain.one) or domain.one
-        threshold = scale * mpmath.mpf(10) ** (-(domain.dps - 3))
-    for column in range(size):
-        if exact:
-            pivot = next((r for r in range(column, size) if rows[r][column]), None)
-        else:
-            pivot = max(range(column, size), key=lambda r: abs(rows[r][column]))
-            pivot = pivot if abs(rows[pivot][column]) > threshold else None
-        if pivot is None:
-            raise ResonanceError(f"the order-{order} matching system is singular (internal resonance or tangent contact)")
-        rows[column], rows[pivot] = rows[pivot], rows[column]
-        for r in range(column + 1, size):
-            factor = rows[r][column] / rows[column][column]
-            if factor:
-                rows[r] = [a - factor * b for a, b in zip(rows[r], rows[column])]
-    solution = [domain.zero] * size
-    for r in range(size - 1, -1, -1):
-        total = rows[r][size]
-        for c in range(r + 1, size):
-            total = total - rows[r][c] * solution[c]
-        solution[r] = total / rows[r][r]
-    return solution
-
-
 def _combination(domain: Any, branches: Sequence[Branch], weights: Sequence[Any]) -> Branch:
     """Σ_l weights[l] · branches[l], accumulated in one dictionary (a chain of Branch sums would copy O(N²) terms)."""
     terms: dict = {}
@@ -255,7 +192,7 @@ class BranchHierarchy(LazyOrders):
         ]
         self._lag = int(any(boundary.grazing for boundary in system.boundaries))
         self._derivatives: dict[tuple[int, int, int, int], Branch] = {}
-        self._law_powers: dict[tuple[int, int, int, int], Branch] = {}
+        self._law_powers: dict[tuple, Branch] = {}
         # per stretched arc (first, last piece): its length ℓ_n (ℓ = s_1* or π − s_L*), μ_n = [Ω²/ℓ²]_n and
         # Q_n = [Y'(1)/ℓ]_n, the slope it hands to its neighbour (Q_0 = −sin β)
         self._arc_data: list[dict[str, list[Any]] | None] = []
@@ -347,6 +284,41 @@ class BranchHierarchy(LazyOrders):
                 for i in range(order + 1):
                     result = result + self._law_power(piece, element, power - 1, i) * \
                         self._law_power(piece, element, 1, order - i)
+            self._law_powers[key] = result
+        return self._law_powers[key]
+
+    def _analytic_force(self, piece: int, element: int, order: int) -> Branch:
+        """[f(y)]_order of an analytic element on ``piece``: Σ_m g_m [δ^m]_order, δ = y − y_0, memoised."""
+        key = ("force", piece, element, order)
+        if key not in self._law_powers:
+            law = self.system.states[piece].analytic[element][2]
+            total = Branch(self._domain)
+            for m in range(order + 1):
+                deviation = self._deviation(piece, element, m, order)
+                if deviation.terms:
+                    total = total + law.branch(m) * deviation
+            self._law_powers[key] = total
+        return self._law_powers[key]
+
+    def _deviation(self, piece: int, element: int, power: int, order: int) -> Branch:
+        """[δ^power]_order on ``piece`` for an analytic element, δ = Σ_{n≥1} ε̂^n (c · W_n)."""
+        key = ("deviation", piece, element, power, order)
+        if key not in self._law_powers:
+            domain = self._domain
+            if power == 0:
+                result = Branch.constant(domain, domain.one) if order == 0 else Branch(domain)
+            elif order < power:
+                result = Branch(domain)
+            elif power == 1:
+                coupling = self.system.states[piece].analytic[element][1]
+                nonzero = [k for k, weight in enumerate(coupling) if weight]
+                branches = self._branches[order][piece]
+                result = _combination(domain, [branches[k] for k in nonzero], [coupling[k] for k in nonzero])
+            else:
+                result = Branch(domain)
+                for i in range(1, order - power + 2):
+                    result = result + self._deviation(piece, element, 1, i) * self._deviation(piece, element, power - 1,
+                                                                                               order - i)
             self._law_powers[key] = result
         return self._law_powers[key]
 
@@ -478,6 +450,9 @@ class BranchHierarchy(LazyOrders):
                 if order == system.gauge and state.load[k]:
                     rhs = rhs - Branch.constant(domain, state.load[k])
                 if order >= system.gauge:
+                    for element, (forcing, _, _) in enumerate(state.analytic):
+                        if forcing[k]:
+                            rhs = rhs - self._analytic_force(piece, element, order - system.gauge).scale(forcing[k])
                     for element, (forcing, _, powers) in enumerate(state.elements):
                         if forcing[k]:
                             for power, coefficient in powers:

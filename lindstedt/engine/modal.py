@@ -1,4 +1,4 @@
-"""The modal normal form of an N-dof unilateral system:  M X'' + K X + ε W (A X − b)_+ = 0.
+"""The modal normal form of an N-dof system:  M X'' + K X + ε Σ_i w_i f_i(a_iᵀ X − b_i) = 0.
 
 Seed §4 (Theorem 4.1, Corollary 4.2), derived here from the equations.  With
 the modes ``K Φ = M Φ Λ²``, ``Φᵀ M Φ = I`` and ``X = Φ U``:
@@ -24,6 +24,16 @@ projections ``B = A Φ``, ``G = Φᵀ W`` (O(N·m) numbers, from
 :meth:`~lindstedt.problems.system.UnilateralSystem.modal_coupling`: float64 modes
 refined in multiprecision), and ``L_p`` enters the hierarchy as its rank-one terms
 ``G_i B_iᵀ`` (:class:`~lindstedt.engine.branches.ContactState`), never as an N × N matrix.
+
+**Any law.**  Element i's law ``f_i`` is split at its breakpoints ``p`` into polynomial pieces
+(:func:`~lindstedt.problems.piecewise_linear.decompose_piecewise`); each breakpoint is a candidate boundary, crossed
+where the order-zero deformation ``a0 B_ij cos s − b_i`` reaches p (``κ = (b_i + p)/(a0 B_ij)``), and on every piece
+of [0, π] a sample angle picks each element's polynomial ``Σ_m c_m u^m``.  In ``y = B_i·W``,
+``f_i(a0 y − b_i)/a0 = Σ_l e_l y^l`` (binomial expansion): ``e_0`` joins the load, ``e_1`` the rank-one stiffness
+``e_1 G_i B_iᵀ`` and the powers ``l ≥ 2`` act on the deformation ``y`` with the force direction ``G_i``
+(``ContactState.elements``: products of branches).  Unilateral springs are the case ``f = (·)_+``, one breakpoint 0.
+A fractional power ``c |u − p|^q`` (Hertz) on the contact interval that holds the release point makes the first
+piece a stretched arc (:class:`~lindstedt.engine.stretched.VectorArc`).
 """
 
 from __future__ import annotations
@@ -39,9 +49,9 @@ import sympy
 from sympy import RealField
 
 from .._errors import ProblemError, ResonanceError, UnsupportedNonlinearityError
-from .._precision import locked
+from .._precision import locked, workdps
 from ..problems.system import UnilateralSystem
-from ..algebra.branch import EvaluationPoint
+from ..algebra.branch import Branch, EvaluationPoint
 from .branches import BranchHierarchy, BranchSystem, ContactState, MovingBoundary
 from .stretched import VectorArc
 
@@ -74,6 +84,7 @@ class _PiecewisePolynomial:
     breakpoints: tuple[Any, ...]
     pieces: tuple[tuple[Any, ...], ...]
     fractional: tuple[tuple[tuple[Any, Any, Fraction], ...], ...] = ()
+    analytic: tuple[sympy.Expr, ...] = ()  # the analytic non-polynomial part per interval (0: none)
 
     def interval(self, deformation: Any) -> int:
         """Index of the interval holding a deformation (not on a breakpoint)."""
@@ -82,22 +93,73 @@ class _PiecewisePolynomial:
 
 def _piecewise_polynomial(law: sympy.Expr, convert: Any) -> _PiecewisePolynomial:
     """Breakpoints and polynomial pieces of an element's law, or an UnsupportedNonlinearityError naming shooting."""
-    from ..problems.piecewise_linear import decompose_piecewise, has_non_polynomial_law
+    from ..problems.piecewise_linear import decompose_piecewise
     from ..problems.system import LAW_VARIABLE
 
-    intervals = decompose_piecewise(law, LAW_VARIABLE) if has_non_polynomial_law(law, LAW_VARIABLE) else None
-    if intervals is None:
-        intervals = decompose_piecewise(law, LAW_VARIABLE)
-    elif any(interval.analytic != 0 for interval in intervals):
-        raise UnsupportedNonlinearityError(
-            f"the N-dof strained-coordinates NNM takes laws polynomial between breakpoints, plus a fractional power "
-            f"of the distance to a breakpoint (Hertz); {law} has an analytic non-polynomial part: compute its NNMs "
-            "by shooting (nnm_point, continue_nnm), or expand the one-degree-of-freedom problem with lindstedt.expand")
+    intervals = decompose_piecewise(law, LAW_VARIABLE)
     return _PiecewisePolynomial(
         tuple(convert(interval.upper) for interval in intervals[:-1]),
         tuple(tuple(convert(c) for c in interval.coefficients) for interval in intervals),
         tuple(tuple((convert(c), convert(point), Fraction(int(p.p), int(p.q))) for c, point, p in interval.fractional)
-              for interval in intervals))
+              for interval in intervals),
+        tuple(interval.analytic for interval in intervals))
+
+
+class _AnalyticElement:
+    """The analytic part f_a of an element's law along the NNM, as the cosine series of its Taylor coefficients.
+
+    With ``y = B_i·W``, ``y_0 = B_ij cos s`` and ``h(w) = f_a(a0 B_ij w − b_i)/a0``, the force is
+    ``f_a(a0 y − b_i)/a0 = Σ_m g_m(s) (y − y_0)^m``, ``g_m = h^{(m)}(cos s)/(m! B_ij^m)``: the Chebyshev
+    coefficients of h^{(m)}/m! (one sampling, the derivative recurrence: :mod:`lindstedt.engine.smooth`, which
+    checks that h is analytic on the orbit) are the cosine coefficients of g_m.  An element that mode j does not
+    move (B_ij = 0) has the constants ``g_m = f_a^{(m)}(−b_i) a0^{m−1}/m!``.
+    """
+
+    def __init__(self, law: sympy.Expr, expression: sympy.Expr, a0: Any, coupling: Any, gap: Any, domain: Any,
+                 digits: int):
+        from types import SimpleNamespace
+
+        from ..problems.system import LAW_VARIABLE
+        from .smooth import _NORMALISED, _ChebyshevTaylor, _check_continuous_on_orbit
+
+        def number(value: Any) -> sympy.Float:
+            return sympy.N(value, digits + 10) if isinstance(value, sympy.Basic) else sympy.Float(mpmath.mpf(value),
+                                                                                                    digits + 10)
+
+        self._domain, self._digits, self._cache = domain, digits, {}
+        self._a0, self._coupling, gap = number(a0), number(coupling), number(gap)
+        if abs(self._coupling) <= sympy.Float(10) ** (-digits):
+            point = -gap
+            self._constants = [sympy.diff(expression, LAW_VARIABLE, m).subs(LAW_VARIABLE, point) for m in range(40)]
+            self._taylor = None
+            return
+        self._constants = None
+        scaled = expression.subs(LAW_VARIABLE, self._a0 * self._coupling * _NORMALISED - gap) / self._a0
+        # the orbit of the deformation, in the words of the 1-dof checks (f, and the amplitude a0 B_ij)
+        describe = SimpleNamespace(f=law, a0=self._a0 * self._coupling)
+        _check_continuous_on_orbit(scaled, describe)
+        self._taylor = _ChebyshevTaylor(scaled, digits, describe)
+
+    def branch(self, power: int) -> Branch:
+        """g_power as a branch (cosine terms)."""
+        if power not in self._cache:
+            with workdps(self._digits + 20):  # mpmath arithmetic at the global precision would round to a double
+                self._cache[power] = self._series(power)
+        return self._cache[power]
+
+    def _series(self, power: int) -> Branch:
+        domain = self._domain
+        if self._taylor is None:
+            if power >= len(self._constants):
+                raise UnsupportedNonlinearityError("more than 40 Taylor terms of an analytic element law")
+            value = self._constants[power] * self._a0 ** (power - 1) / math.factorial(power)
+            return Branch.constant(domain, domain.dtype(mpmath.mpf(sympy.N(value, self._digits + 10))))
+        coefficients = self._taylor.coefficients(power)
+        scale = mpmath.mpf(sympy.N(self._coupling, self._digits + 10)) ** power
+        size = max((abs(c) for c in coefficients), default=mpmath.mpf(0))
+        threshold = size * mpmath.mpf(10) ** (-(self._digits + 2))
+        return Branch(domain, {(n, 0, 0): domain.dtype(c / scale)
+                               for n, c in enumerate(coefficients) if c and abs(c) > threshold})
 
 
 @dataclass(frozen=True)
@@ -222,6 +284,23 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
         return terms[0], (terms[1] if len(terms) > 1 else domain.zero), \
             tuple((l, e) for l, e in enumerate(terms) if l >= 2 and e)
 
+    analytic_elements: dict[tuple[int, int], _AnalyticElement] = {}
+
+    def analytic_element(i: int, interval: int) -> _AnalyticElement:
+        """Element i's analytic part on one interval of its law; the deformation must stay inside the interval
+        along the whole orbit (no breakpoint of that element crossed: the Taylor series about y_0(s) holds on
+        every piece)."""
+        key = (i, interval)
+        if key not in analytic_elements:
+            if any(spring.element == i and spring.status in ("crossing", "grazing") for spring in springs):
+                raise UnsupportedNonlinearityError(
+                    f"the N-dof strained-coordinates NNM takes an analytic law ({system.laws[i]}) on an element whose "
+                    "deformation stays between two breakpoints of its law along the orbit; element "
+                    f"{i + 1} crosses one: compute its NNMs by shooting (nnm_point, continue_nnm)")
+            analytic_elements[key] = _AnalyticElement(system.laws[i], laws[i].analytic[interval], amplitude,
+                                                      coupling_rows[i][mode], list(system.b_exact)[i], domain, digits)
+        return analytic_elements[key]
+
     def assemble(crossed: dict[int, Any]) -> BranchSystem:
         """The branch system; ``crossed`` maps a grazing boundary the perturbed orbit passes to its σ_1."""
         top = [s for s in springs if s.index in crossed and s.kappa > 0]
@@ -254,7 +333,7 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
         for piece, (middle, flips) in enumerate(zip(samples, flipped)):
             cosine = middle.context.cos(middle)
             load = [domain.zero] * size
-            rank_one, elements = [], []
+            rank_one, elements, analytic = [], [], []
             for i, law in enumerate(laws):
                 interval = law.interval(a0 * B[i][mode] * cosine - gaps[i])
                 for spring in springs:
@@ -262,6 +341,8 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
                         interval = spring.breakpoint + 1 if interval == spring.breakpoint else spring.breakpoint
                 if law.fractional and law.fractional[interval]:
                     fractional.append((piece, i, interval))
+                if law.analytic and law.analytic[interval] != 0:
+                    analytic.append((forcing_columns[i], coupling_vectors[i], analytic_element(i, interval)))
                 constant, linear, powers = element_law(i, interval)
                 if constant:
                     for k in range(size):
@@ -271,7 +352,8 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
                                      else tuple(linear * c for c in coupling_vectors[i])))
                 if powers:
                     elements.append((forcing_columns[i], coupling_vectors[i], powers))
-            states.append(ContactState((), tuple(load), elements=tuple(elements), rank_one=tuple(rank_one)))
+            states.append(ContactState((), tuple(load), elements=tuple(elements), rank_one=tuple(rank_one),
+                                       analytic=tuple(analytic)))
         arc = _release_arc(fractional, states, crossing, boundaries, crossed) if fractional else None
         return BranchSystem(
             domain=domain,

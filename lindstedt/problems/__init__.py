@@ -3,7 +3,9 @@
 * :mod:`~lindstedt.problems.parsing` — the AST-whitelist parser (every user string goes through it);
 * :mod:`~lindstedt.problems.oscillator` — ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0``, ``u'(0) = 0``;
 * :mod:`~lindstedt.problems.piecewise_linear` — a continuous piecewise-linear f split into linear intervals;
-* :mod:`~lindstedt.problems.system` — ``M X'' + K X + ε W (A X − b)_+ = 0`` and its linear modes;
+* :mod:`~lindstedt.problems.system` — ``M X'' + K X + ε Σ_i w_i f_i(a_iᵀ X − b_i) = 0`` (unilateral springs by default,
+  any law per element) and its linear modes;
+* :mod:`~lindstedt.problems.couplings` — a polynomial force ``ε g(X)`` turned exactly into elements ``ε w (aᵀX)^d``;
 * :mod:`~lindstedt.problems.matrices` — exact matrices read from user input, and their float copies;
 * :mod:`~lindstedt.problems.modes` — the linear modes ``K Φ = M Φ diag(λ²)``, float64 then multiprecision;
 * :mod:`~lindstedt.problems.structures` — ``M``, ``K`` (``C``) read from ``.npz``/``.mat``/``.mtx`` files, and the

@@ -6,10 +6,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from .._errors import ProblemError, UnsupportedNonlinearityError
+from .._errors import ProblemError
 from .._precision import locked_methods
 from .parsing import parse_real
-from .piecewise_linear import decompose_piecewise, has_non_polynomial_law
+from .piecewise_linear import decompose_piecewise
 from .system import LAW_VARIABLE, UnilateralSystem
 
 __all__ = ["NNMProblem"]
@@ -47,14 +47,8 @@ class NNMProblem:
     def __post_init__(self) -> None:
         if not isinstance(self.system, UnilateralSystem):
             raise ProblemError("system must be a UnilateralSystem (see UnilateralSystem.from_json_dict)")
-        for law in self.system.laws:
-            if has_non_polynomial_law(law, LAW_VARIABLE) and any(
-                    interval.analytic != 0 for interval in decompose_piecewise(law, LAW_VARIABLE)):
-                raise UnsupportedNonlinearityError(
-                    f"the N-dof strained-coordinates NNM (lindstedt.nnm) takes laws that are polynomial between "
-                    f"breakpoints, with a fractional power of the distance to one (Hertz); {law} has an analytic "
-                    "non-polynomial part: compute its NNMs by shooting (lindstedt.nnm_point, continue_nnm), or expand "
-                    "one degree of freedom with lindstedt.expand")
+        for law in self.system.laws:  # every law must split into pieces (polynomial, Hertz, analytic): else a typed error
+            decompose_piecewise(law, LAW_VARIABLE)
         if isinstance(self.mode, bool) or not isinstance(self.mode, int) or not 1 <= self.mode <= self.system.n_dof:
             raise ProblemError(f"mode must be an integer between 1 and {self.system.n_dof}, got {self.mode!r}")
         amplitude = parse_real(self.a0, what="a0")

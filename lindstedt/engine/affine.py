@@ -1,0 +1,82 @@
+"""Exact linear algebra of one order of the branch hierarchy: values affine in the order's unknowns, and the
+Gaussian elimination that fixes them (:mod:`lindstedt.engine.branches`).
+
+Every condition of order n — the slopes at 0 and π, the matching at the moving boundaries, the contact conditions
+and the normalisation — is affine in the unknowns ``(A_n, c_k …)``: ``base + Σ coefficient · unknown``.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import mpmath
+
+from .._errors import ResonanceError
+
+__all__ = ["solve_linear"]
+
+
+class _Affine:
+    """A value of order n, affine in the unknowns (A_n, c_1 … c_N): base + Σ coefficient·unknown."""
+
+    __slots__ = ("base", "coefficients")
+
+    def __init__(self, base: Any, coefficients: list[Any]):
+        self.base = base
+        self.coefficients = coefficients
+
+    def __add__(self, other: "_Affine") -> "_Affine":
+        return _Affine(self.base + other.base, [a + b for a, b in zip(self.coefficients, other.coefficients)])
+
+    def __sub__(self, other: "_Affine") -> "_Affine":
+        return _Affine(self.base - other.base, [a - b for a, b in zip(self.coefficients, other.coefficients)])
+
+    def scale(self, factor: Any) -> "_Affine":
+        return _Affine(self.base * factor, [a * factor for a in self.coefficients])
+
+    def shift(self, constant: Any) -> "_Affine":
+        return _Affine(self.base + constant, list(self.coefficients))
+
+    def value(self, unknowns: Sequence[Any]) -> Any:
+        total = self.base
+        for coefficient, unknown in zip(self.coefficients, unknowns):
+            total = total + coefficient * unknown
+        return total
+
+
+def solve_linear(matrix: list[list[Any]], vector: list[Any], domain: Any, order: int) -> list[Any]:
+    """Gaussian elimination in ``domain``: partial pivoting for floats, first nonzero pivot when exact.
+
+    Kept because measured (40 digits, random systems of the package's sizes N + 1 = 3, 6, 21):
+    61 µs, 0.94 ms, 10 ms here against 5.7, 5.6 and 26 ms for ``mpmath.lu_solve`` with the
+    conversions to and from mpf matrices (whose naive round trip through ``RealField.convert``
+    also fell to 1e-16); exact 2 × 2 over ``QQ(p, k)``: 1.5 ms here, 1.4 ms ``DomainMatrix.lu_solve``
+    (which does not pivot for size, so it cannot serve the float case).
+    """
+    size = len(vector)
+    rows = [row[:] + [value] for row, value in zip(matrix, vector)]
+    exact = domain.is_Exact
+    threshold = None
+    if not exact:
+        scale = max((abs(entry) for row in matrix for entry in row), default=domain.one) or domain.one
+        threshold = scale * mpmath.mpf(10) ** (-(domain.dps - 3))
+    for column in range(size):
+        if exact:
+            pivot = next((r for r in range(column, size) if rows[r][column]), None)
+        else:
+            pivot = max(range(column, size), key=lambda r: abs(rows[r][column]))
+            pivot = pivot if abs(rows[pivot][column]) > threshold else None
+        if pivot is None:
+            raise ResonanceError(f"the order-{order} matching system is singular (internal resonance or tangent contact)")
+        rows[column], rows[pivot] = rows[pivot], rows[column]
+        for r in range(column + 1, size):
+            factor = rows[r][column] / rows[column][column]
+            if factor:
+                rows[r] = [a - factor * b for a, b in zip(rows[r], rows[column])]
+    solution = [domain.zero] * size
+    for r in range(size - 1, -1, -1):
+        total = rows[r][size]
+        for c in range(r + 1, size):
+            total = total - rows[r][c] * solution[c]
+        solution[r] = total / rows[r][r]
+    return solution
