@@ -205,3 +205,51 @@ def test_hertz_chain_orbits_near_each_fold_are_the_steady_states_of_the_ode(hert
         drift = float(np.max(np.abs(states - point.state)))
         assert drift <= 3 * (closure + error) / (1 - rho), (point.frequency, drift, closure, error, rho)
         assert drift < 1e-8
+
+
+@pytest.mark.slow  # ~15 s: 3 orbits, 2 runs off the saddle, a run from rest
+def test_hertz_chain_between_the_folds_two_stable_responses_and_a_saddle(hertz):
+    upper, lower = _folds(hertz)
+    omega = 0.5 * (upper.frequency + lower.frequency)
+    guesses = [hertz.states[upper.index], hertz.states[(upper.index + lower.index + 1) // 2],
+               hertz.states[lower.index + 1]]
+    orbits = [_orbit(omega, guess) for guess in guesses]
+    states = np.array([orbit.state for orbit in orbits])
+    assert min(np.max(np.abs(states[i] - states[j])) for i, j in ((0, 1), (1, 2), (0, 2))) > 0.05  # three distinct
+    multipliers = [_multipliers(state, omega) for state in states]
+    assert [bool(abs(mu[0]) < 1) for mu in multipliers] == [True, False, True] == [o.stable for o in orbits]
+    saddle = multipliers[1]
+    assert abs(saddle[0].imag) < 1e-12 and saddle[0].real > 1.02 and abs(saddle[1]) < 1  # one real multiplier > 1
+    # off the saddle along its unstable direction (of the hand-written monodromy): one side lands on the upper
+    # response, the other on the lower one — the two attractors the folds bound, each reached by a transient
+    values, vectors = np.linalg.eig(_monodromy(states[1], omega))
+    direction = np.real(vectors[:, np.argmax(np.abs(values))])
+    # (the saddle's μ = 1.04 takes ~120 periods to grow 1e-3 to 0.1; then |μ| = 0.94 contracts onto the response)
+    ends = [_periods(states[1] + sign * 1e-3 * direction / np.max(np.abs(direction)), omega, 450, rtol=1e-10)[-1]
+            for sign in (1, -1)]
+    landed = sorted(int(np.argmin([np.max(np.abs(end - states[i])) for i in range(3)])) for end in ends)
+    assert landed == [0, 2], landed
+    for end in ends:
+        assert min(np.max(np.abs(end - states[i])) for i in (0, 2)) < 1e-6
+    # from rest the chain settles on the lower response (the upper one needs a large enough start)
+    assert np.max(np.abs(_periods(np.zeros(4), omega, 300, rtol=1e-10)[-1] - states[2])) < 1e-6
+
+
+@pytest.mark.slow  # ~8 s: four 300-period runs
+def test_hertz_chain_each_fold_bounds_its_response_a_run_past_it_jumps(hertz):
+    upper, lower = _folds(hertz)
+    delta = 2e-3
+    for fold, outward, other in ((upper, +1, hertz.states[lower.index + 1]), (lower, -1, hertz.states[upper.index])):
+        # δ inside: the response continued from the fold's state is there, stable, beside the other one, and a
+        # run from it stays on it
+        inside = _orbit(fold.frequency - outward * delta, fold.state)
+        beside = _orbit(inside.frequency, other)
+        assert inside.stable and beside.stable and np.max(np.abs(inside.state - beside.state)) > 0.1
+        # (to the rtol-1e-10 run's error over the contraction, measured ≤ 1.2e-8; a jump would move it by > 0.1)
+        assert np.max(np.abs(_periods(inside.state, inside.frequency, 300, rtol=1e-10)[-1] - inside.state)) < 1e-6
+        # δ outside: that part of the branch is gone; the run from the fold's state goes to the other response
+        omega = fold.frequency + outward * delta
+        target = _orbit(omega, other)
+        assert target.stable and np.max(np.abs(target.state - fold.state)) > 0.1
+        end = _periods(fold.state, omega, 300, rtol=1e-10)[-1]
+        assert np.max(np.abs(end - target.state)) < 1e-6, (omega, np.max(np.abs(end - target.state)))
