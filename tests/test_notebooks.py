@@ -33,6 +33,7 @@ NAMES = (
     "forced_response.ipynb",
     "hertz_backbone.ipynb",
     "peer_nlvib02.ipynb",
+    "peer_nlvib03.ipynb",
     "peer_sdnd123.ipynb",
     "runtime_vs_error.ipynb",
     "validity_time.ipynb",
@@ -56,6 +57,7 @@ PLOT_FUNCTIONS = {
     "forced_response.ipynb": {"frequency_response", "spectrum"},
     "peer_sdnd123.ipynb": {"branch"},
     "peer_nlvib02.ipynb": {"frequency_response"},
+    "peer_nlvib03.ipynb": {"frequency_response"},
 }
 #: the figures (image/png outputs) each executed notebook shows, at least
 FIGURES = {
@@ -69,6 +71,7 @@ FIGURES = {
     "forced_response.ipynb": 3,
     "peer_sdnd123.ipynb": 1,
     "peer_nlvib02.ipynb": 3,
+    "peer_nlvib03.ipynb": 3,
 }
 #: rich displays of results (the last expression of a cell): (mime type, fragments that one such output contains)
 DISPLAYS = {
@@ -91,6 +94,7 @@ DISPLAYS = {
     ],
     "peer_sdnd123.ipynb": [("text/html", ['<table class="lindstedt">', "<b>NNMBranch: "])],
     "peer_nlvib02.ipynb": [("text/html", ['<table class="lindstedt">', "<b>FrequencyResponse: "])],
+    "peer_nlvib03.ipynb": [("text/html", ['<table class="lindstedt">', "<b>FrequencyResponse: "])],
     "hertz_backbone.ipynb": [
         ("text/latex", ["Stretched contact arc", r"|u - b|^{3/2}"]),
         ("text/html", ['<table class="lindstedt">', "<b>StretchedArcSeries"]),
@@ -150,7 +154,8 @@ def _client_modules():
 
 
 #: notebooks taking 5–20 s each: executed by `pytest -m slow` (CI runs it) and by every build of the docs site
-HEAVY = ("backbone.ipynb", "hertz_backbone.ipynb", "peer_sdnd123.ipynb", "peer_nlvib02.ipynb")
+HEAVY = ("backbone.ipynb", "hertz_backbone.ipynb", "peer_sdnd123.ipynb", "peer_nlvib02.ipynb",
+         "peer_nlvib03.ipynb")
 
 
 @pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.slow) if name in HEAVY else name for name in NAMES])
