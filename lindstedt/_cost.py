@@ -211,11 +211,45 @@ _NNM = (-13.176, 1.475, 1.084, 3.985)
 _NNM_MEMORY = (3.5e-4, 12.0)
 
 
+#: Elements of other laws (measured on chains with a gap spring and one element, a0 = 3, this machine):
+#: a Hertz contact arc costs ``_NNM_ARC · N · (order + 1)`` s (mpmath Chebyshev integrals at 128 nodes per component
+#: and order: 0.22 s at N = 5, order 1; 9.98 s at N = 20, order 3); products of branches (powers ≥ 2, analytic laws)
+#: cost ``_NNM_PRODUCTS · N^1.6 · 9^(order − 2)`` s from order 3 on (combination tones of the N modal frequencies:
+#: sin(u) with a crossing, 1.28 s at N = 5, order 3; 11.9 s at N = 5, order 4; 12.1 s at N = 20, order 3); order 2
+#: stays linear in N (0.77 s for a cubic spring at N = 200).
+_NNM_ARC, _NNM_PRODUCTS = 0.12, 0.015
+
+
+def _law_costs(system: Any) -> tuple[bool, bool]:
+    """(a law has a fractional power — a Hertz arc; a law multiplies branches — a piece of degree ≥ 2 or an analytic
+    part), read from the laws' pieces."""
+    from ._errors import LindstedtError
+    from .problems.piecewise_linear import decompose_piecewise
+    from .problems.system import LAW_VARIABLE, UNILATERAL
+
+    fractional = products = False
+    for law in set(getattr(system, "laws", ())):
+        if law == UNILATERAL:
+            continue
+        try:
+            intervals = decompose_piecewise(law, LAW_VARIABLE)
+        except LindstedtError:  # refused by the method itself, with its own words
+            continue
+        fractional = fractional or any(interval.fractional for interval in intervals)
+        products = products or any(len(interval.coefficients) > 2 or interval.analytic != 0 for interval in intervals)
+    return fractional, products
+
+
 def nnm_estimate(system: Any, mode: int, order: int) -> Estimate:
     """The :class:`~lindstedt.limits.Estimate` of the strained-coordinates NNM of ``system`` to ``order``."""
     n, springs = system.n_dof, max(len(system.b), 1)
     constant, per_dof, per_spring, per_order = _NNM
     seconds = math.exp(constant) * n**per_dof * springs**per_spring * (order + 1) ** per_order
+    fractional, products = _law_costs(system)
+    if fractional:
+        seconds += _NNM_ARC * n * (order + 1)
+    if products and order >= 3:
+        seconds += _NNM_PRODUCTS * n**1.6 * 9.0 ** (order - 2)
     memory = max(1.0, _NNM_MEMORY[0] * n * n, _NNM_MEMORY[1] * seconds**0.9)
     return Estimate(task=f"NNM expansion of mode {mode} of a {n}-dof system to order {order}", seconds=seconds,
                     memory_mb=memory, drivers=(("degrees of freedom", n), ("springs", springs), ("order", order)),

@@ -50,7 +50,7 @@ def _energy_integral_period(potential, release: float, other_side: float, kinks:
         return float(2 * mpmath.quad(lambda x: 1 / mpmath.sqrt(abs(2 * (level - potential(x)))), nodes))
 
 
-@pytest.mark.parametrize("epsilon", [0.01, 0.3, 3.0])
+@pytest.mark.parametrize("epsilon", [0.01, 0.3, pytest.param(3.0, marks=pytest.mark.slow)])  # 3.0: by continuation
 def test_the_nnm_of_a_cubic_spring_is_the_elliptic_closed_form(epsilon):
     system = UnilateralSystem(M=[[1]], K=[[1]], A=[[1]], laws=["u**3"])
     orbit = nnm_point(system, epsilon, 1, modal_amplitude=1.0)

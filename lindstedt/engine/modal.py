@@ -50,7 +50,7 @@ from sympy import RealField
 
 from .._errors import ProblemError, ResonanceError, UnsupportedNonlinearityError
 from .._precision import locked, workdps
-from ..problems.system import UnilateralSystem
+from ..problems.system import LAW_VARIABLE, UnilateralSystem
 from ..algebra.branch import Branch, EvaluationPoint
 from .branches import BranchHierarchy, BranchSystem, ContactState, MovingBoundary
 from .stretched import VectorArc
@@ -85,6 +85,8 @@ class _PiecewisePolynomial:
     pieces: tuple[tuple[Any, ...], ...]
     fractional: tuple[tuple[tuple[Any, Any, Fraction], ...], ...] = ()
     analytic: tuple[sympy.Expr, ...] = ()  # the analytic non-polynomial part per interval (0: none)
+    #: per interval, the fractional terms exactly: (c, p, q, side) for c·(side·(u − p))^q, side = +1 above p
+    exact_fractional: tuple[tuple[tuple[sympy.Expr, sympy.Expr, sympy.Rational, int], ...], ...] = ()
 
     def interval(self, deformation: Any) -> int:
         """Index of the interval holding a deformation (not on a breakpoint)."""
@@ -94,7 +96,6 @@ class _PiecewisePolynomial:
 def _piecewise_polynomial(law: sympy.Expr, convert: Any) -> _PiecewisePolynomial:
     """Breakpoints and polynomial pieces of an element's law, or an UnsupportedNonlinearityError naming shooting."""
     from ..problems.piecewise_linear import decompose_piecewise
-    from ..problems.system import LAW_VARIABLE
 
     intervals = decompose_piecewise(law, LAW_VARIABLE)
     return _PiecewisePolynomial(
@@ -102,7 +103,9 @@ def _piecewise_polynomial(law: sympy.Expr, convert: Any) -> _PiecewisePolynomial
         tuple(tuple(convert(c) for c in interval.coefficients) for interval in intervals),
         tuple(tuple((convert(c), convert(point), Fraction(int(p.p), int(p.q))) for c, point, p in interval.fractional)
               for interval in intervals),
-        tuple(interval.analytic for interval in intervals))
+        tuple(interval.analytic for interval in intervals),
+        tuple(tuple((c, point, p, 1 if point == interval.lower else -1) for c, point, p in interval.fractional)
+              for interval in intervals))
 
 
 class _AnalyticElement:
@@ -119,7 +122,6 @@ class _AnalyticElement:
                  digits: int):
         from types import SimpleNamespace
 
-        from ..problems.system import LAW_VARIABLE
         from .smooth import _NORMALISED, _ChebyshevTaylor, _check_continuous_on_orbit
 
         def number(value: Any) -> sympy.Float:
@@ -286,18 +288,25 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
 
     analytic_elements: dict[tuple[int, int], _AnalyticElement] = {}
 
+    def moved_across(i: int) -> bool:
+        """Whether the orbit crosses (or grazes) a breakpoint of element i's law."""
+        return any(spring.element == i and spring.status in ("crossing", "grazing") for spring in springs)
+
     def analytic_element(i: int, interval: int) -> _AnalyticElement:
         """Element i's analytic part on one interval of its law; the deformation must stay inside the interval
         along the whole orbit (no breakpoint of that element crossed: the Taylor series about y_0(s) holds on
         every piece)."""
         key = (i, interval)
         if key not in analytic_elements:
-            if any(spring.element == i and spring.status in ("crossing", "grazing") for spring in springs):
+            if moved_across(i):
                 raise UnsupportedNonlinearityError(
                     f"the N-dof strained-coordinates NNM takes an analytic law ({system.laws[i]}) on an element whose "
                     "deformation stays between two breakpoints of its law along the orbit; element "
                     f"{i + 1} crosses one: compute its NNMs by shooting (nnm_point, continue_nnm)")
-            analytic_elements[key] = _AnalyticElement(system.laws[i], laws[i].analytic[interval], amplitude,
+            expression = laws[i].analytic[interval] + sum(  # c |u − p|^q on the side of p the orbit stays on
+                (c * (side * (LAW_VARIABLE - point)) ** q for c, point, q, side in laws[i].exact_fractional[interval]),
+                sympy.S.Zero)
+            analytic_elements[key] = _AnalyticElement(system.laws[i], expression, amplitude,
                                                       coupling_rows[i][mode], list(system.b_exact)[i], domain, digits)
         return analytic_elements[key]
 
@@ -339,9 +348,10 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
                 for spring in springs:
                     if spring.index in flips and spring.element == i:  # across the grazed breakpoint
                         interval = spring.breakpoint + 1 if interval == spring.breakpoint else spring.breakpoint
-                if law.fractional and law.fractional[interval]:
+                if law.fractional and law.fractional[interval] and moved_across(i):
                     fractional.append((piece, i, interval))
-                if law.analytic and law.analytic[interval] != 0:
+                elif law.analytic[interval] != 0 or law.fractional[interval]:
+                    # a fractional term in contact along the whole orbit is analytic there: expanded like one
                     analytic.append((forcing_columns[i], coupling_vectors[i], analytic_element(i, interval)))
                 constant, linear, powers = element_law(i, interval)
                 if constant:
