@@ -418,7 +418,10 @@ class BranchHierarchy(LazyOrders):
         # then h_n with a last-piece arc; an N-dof first-piece arc (VectorArc): A_n, σ_{1,n}, the release
         # values h_k (k ≠ j) and μ_n
         vector = isinstance(top, VectorArc)
-        unknown_count = size + 1 + (bottom is not None) + vector
+        vector_bottom = isinstance(bottom, VectorArc)
+        # an N-dof last-piece arc adds its far turning values h_k (every k) and μ_n at bottom_base …
+        bottom_base = size + 1 + vector
+        unknown_count = size + 1 + (bottom is not None) + vector + (size if vector_bottom else 0)
         turning = size + 1
 
         def constant(value: Any) -> _Affine:
@@ -541,6 +544,11 @@ class BranchHierarchy(LazyOrders):
         last = last_piece
         if bottom is None:
             equations = [value_of(last, p, c_values[last][p], d_values[last][p], system.pi_point, True) for p in range(size)]
+        elif vector_bottom:
+            index = len(system.boundaries) - 1
+            equations, bottom_mu, bottom_quotient = self._match_last_vector_arc(
+                order, index, shift_values[index], value_of, c_values[last - 1], d_values[last - 1], constant, unit,
+                bottom_base)
         else:
             index = len(system.boundaries) - 1
             bottom_mu, bottom_quotient, slope_condition = self._match_last_arc(
@@ -604,7 +612,13 @@ class BranchHierarchy(LazyOrders):
         elif top is not None:
             self._arc_data[0]["quotient"].append(top_quotient.value(unknowns))
             self._arc_data[0]["length"].append(unknowns[1])
-        if bottom is not None:
+        if vector_bottom:
+            data = self._arc_data[1]
+            data["mu"].append(bottom_mu.value(unknowns))
+            data["quotients"].append([q.value(unknowns) for q in bottom_quotient])
+            data["length"].append(-self._shifts[-1][order])
+            bottom.fix(order, [unknowns[bottom_base + k] for k in range(size)], unknowns[bottom_base + size])
+        elif bottom is not None:
             data = self._arc_data[1]
             data["mu"].append(bottom_mu.value(unknowns))
             data["quotient"].append(bottom_quotient.value(unknowns))
@@ -691,6 +705,42 @@ class BranchHierarchy(LazyOrders):
             c_next.append(x.scale(cos_r) - y.scale(sin_r / ratio))
             d_next.append(x.scale(sin_r) + y.scale(cos_r / ratio))
         return c_next, d_next, quotients, contact
+
+    def _match_last_vector_arc(self, order: int, index: int, shift: _Affine, value_of: Any, c_left: list, d_left: list,
+                               constant: Any, unit: Any, base: int) -> tuple:
+        """The matching of an N-dof last-piece arc (:class:`~lindstedt.engine.stretched.VectorArc`), at order n.
+
+        On (s_L*, π] ``W_k(s) = −Y_k((π − s)/ℓ)``, ``ℓ = π − s_L*`` (``ℓ_n = −σ_{L,n}``, σ from the left piece's
+        contact condition); unknowns ``h_k = Y_{n,k}(0)`` (``base + k``, the far turning values) and ``μ_n``
+        (``base + N``).  Equations: ``W_k(s*) = −Y_k(1)`` and ``W_k'(s*) = Q_k = Y_k'(1)/ℓ`` for every k, and
+        ``A_n = [μ ℓ²]_n``; returns them with μ_n and the Q_{n,k} (affine).
+        """
+        domain, system, arc, data = self._domain, self.system, self.system.arcs[1], self._arc_data[1]
+        size, mode = system.size, system.mode
+        boundary = system.boundaries[index]
+        point, powers = boundary.point, self._shift_powers(index, order)
+        left = len(system.states) - 2
+        ends = arc.response(order)
+        mu = unit(base + size)
+        equations, quotients = [], []
+        for k in range(size):
+            end, end_slope = (domain.dtype(x) for x in ends[k])
+            dh_value, dh_slope, dmu_value, dmu_slope = (domain.dtype(x) for x in arc.end_terms(k))
+            height = unit(base + k)
+            arc_value = constant(end) + height.scale(dh_value) + mu.scale(dmu_value)
+            arc_slope = constant(end_slope) + height.scale(dh_slope) + mu.scale(dmu_slope)
+            known = sum((data["length"][i] * data["quotients"][order - i][k] for i in range(1, order)), domain.zero)
+            quotient = (arc_slope.shift(-known) + shift.scale(data["quotients"][0][k])).scale(domain.one / data["length"][0])
+            quotients.append(quotient)
+            value = value_of(left, k, c_left[k], d_left[k], point, False).shift(self._known(index, left, k, order, 0, powers))
+            slope = value_of(left, k, c_left[k], d_left[k], point, True).shift(self._known(index, left, k, order, 1, powers))
+            if k == mode:  # W_0'(β) σ_n = −sin β σ_n, W_0''(β) σ_n = −cos β σ_n
+                value = value + shift.scale(-boundary.sine)
+                slope = slope + shift.scale(-point.cos_multiple(1))
+            equations.append(value + arc_value)
+            equations.append(slope - quotient)
+        equations.append(self._arc_frequency_condition(1, order, mu, shift.scale(-domain.one), unit))
+        return equations, mu, quotients
 
     def _match_last_arc(self, order: int, boundary: MovingBoundary, powers: list, shift: _Affine, left_slope: _Affine,
                         constant: Any, turning: _Affine) -> tuple:

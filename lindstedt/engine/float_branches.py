@@ -77,10 +77,11 @@ class FloatBranches:
                     values = arc.evaluate(points / length, weights, derivative)
                     result[mask, component] = values * sign[mask] / length if derivative else values
                 continue
-            if piece == len(pieces) - 1 and self.arcs[1] is not None:  # −Y((π − s)/(π − s_L*))
+            if piece == len(pieces) - 1 and self.arcs[1] is not None:  # −Y((π − s)/(π − s_L*)), per component
                 length = np.pi - weights @ shifts[:, -1]
-                values = self.arcs[1].evaluate((np.pi - points) / length, weights, derivative)
-                result[mask, 0] = values * sign[mask] / length if derivative else -values
+                for component, arc in enumerate(self.arcs[1] if isinstance(self.arcs[1], tuple) else (self.arcs[1],)):
+                    values = arc.evaluate((np.pi - points) / length, weights, derivative)
+                    result[mask, component] = values * sign[mask] / length if derivative else -values
                 continue
             for component, groups in enumerate(components):
                 values = sum((_evaluate_terms(*group[:3], weights @ group[3], points, derivative) for group in groups), np.zeros(points.shape))

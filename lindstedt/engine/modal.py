@@ -32,8 +32,10 @@ of [0, π] a sample angle picks each element's polynomial ``Σ_m c_m u^m``.  In 
 ``f_i(a0 y − b_i)/a0 = Σ_l e_l y^l`` (binomial expansion): ``e_0`` joins the load, ``e_1`` the rank-one stiffness
 ``e_1 G_i B_iᵀ`` and the powers ``l ≥ 2`` act on the deformation ``y`` with the force direction ``G_i``
 (``ContactState.elements``: products of branches).  Unilateral springs are the case ``f = (·)_+``, one breakpoint 0.
-A fractional power ``c |u − p|^q`` (Hertz) on the contact interval that holds the release point makes the first
-piece a stretched arc (:class:`~lindstedt.engine.stretched.VectorArc`).
+A fractional power ``c |u − p|^q`` (Hertz) on the contact interval that holds a turning point makes the first
+(release) or the last (far turning point) piece a stretched arc (:class:`~lindstedt.engine.stretched.VectorArc`; the
+far one in ``Y = −W``, ``τ = (π − s)/(π − s_L*)``); in contact along the whole orbit it is analytic there, and
+expanded as such.
 """
 
 from __future__ import annotations
@@ -364,7 +366,7 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
                     elements.append((forcing_columns[i], coupling_vectors[i], powers))
             states.append(ContactState((), tuple(load), elements=tuple(elements), rank_one=tuple(rank_one),
                                        analytic=tuple(analytic)))
-        arc = _release_arc(fractional, states, crossing, boundaries, crossed) if fractional else None
+        arcs = _contact_arc(fractional, states, crossing, boundaries, crossed) if fractional else (None, None)
         return BranchSystem(
             domain=domain,
             ratios=tuple(None if k == mode else ratio for k, ratio in enumerate(ratios)),
@@ -375,33 +377,48 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
             pi_point=pi_point,
             release=(convert(release_correction) * lam * lam / a0,),
             gauge=2 if crossed else 1,
-            arcs=(arc, None),
+            arcs=arcs,
         )
 
-    def _release_arc(fractional: list, states: list, crossing: list, boundaries: list, crossed: dict) -> VectorArc:
-        """The first piece as a stretched arc: one element's fractional (Hertz) term in contact around the release
-        point, ending where that element's deformation reaches the term's breakpoint (the first boundary)."""
+    def _contact_arc(fractional: list, states: list, crossing: list, boundaries: list,
+                     crossed: dict) -> tuple[VectorArc | None, VectorArc | None]:
+        """The first or the last piece as a stretched arc: one element's fractional (Hertz) term in contact around
+        a turning point (the release, or the far one), ending where that element's deformation reaches the term's
+        breakpoint (the first, or the last, boundary)."""
         supported = ("the N-dof strained-coordinates NNM takes a fractional power law (Hertz) on one element whose "
-                     "contact holds the release point and ends at the first contact angle, without grazing")
+                     "contact holds a turning point and ends at the first or the last contact angle, without grazing")
         piece, i, interval = fractional[0]
-        if len(fractional) != 1 or piece != 0 or crossed or not crossing or len(laws[i].fractional[interval]) != 1:
-            where = ("is in contact at the far turning point (release the mode on the other side, a0 → −a0, or"
-                     if piece != 0 else "is not (or not only) in contact around the release point (")
+        last = len(states) - 1
+        if len(fractional) != 1 or piece not in (0, last) or crossed or not crossing or \
+                len(laws[i].fractional[interval]) != 1 or (piece == 0 and last == 0):
             raise UnsupportedNonlinearityError(
-                f"{supported}; element {i + 1} ({system.laws[i]}) {where} compute its NNMs by shooting: nnm_point, "
-                "continue_nnm)")
+                f"{supported}; element {i + 1} ({system.laws[i]}) is not in contact around one turning point only: "
+                "compute its NNMs by shooting (nnm_point, continue_nnm)")
         c, point, exponent = laws[i].fractional[interval][0]
-        first = crossing[0]
-        if first.element != i or laws[i].breakpoints[first.breakpoint] != point:
+        spring = crossing[0] if piece == 0 else crossing[-1]
+        if spring.element != i or laws[i].breakpoints[spring.breakpoint] != point:
             raise UnsupportedNonlinearityError(
                 f"{supported}; another breakpoint is crossed inside element {i + 1}'s contact arc: compute its NNMs "
                 "by shooting (nnm_point, continue_nnm)")
-        chi = boundaries[0].coupling
+        if states[piece].analytic:
+            raise UnsupportedNonlinearityError(
+                f"{supported}; an analytic law acts on element {i + 1}'s contact arc too: compute its NNMs by shooting "
+                "(nnm_point, continue_nnm)")
+        boundary = boundaries[0] if piece == 0 else boundaries[-1]
+        chi = boundary.coupling
         coefficient = c * abs(chi[mode]) ** domain.convert(sympy.Rational(exponent.numerator, exponent.denominator)) / a0
-        state = states[0]
-        polynomial = (state.load, state.rank_one, state.elements)
-        return VectorArc([domain.one if k == mode else ratio for k, ratio in enumerate(ratios)], mode, chi,
-                         forcing_columns[i], first.kappa, exponent, coefficient, polynomial, digits)
+        state = states[piece]
+        rows = [domain.one if k == mode else ratio for k, ratio in enumerate(ratios)]
+        if piece == 0:
+            return VectorArc(rows, mode, chi, forcing_columns[i], spring.kappa, exponent, coefficient,
+                             (state.load, state.rank_one, state.elements), digits), None
+        # the far arc in Y = −W, τ = (π − s)/ℓ: F̃(Y) = −F(−Y) flips the load, the Hertz force and the odd powers'
+        # signs of the even powers; the deformation's coupling is −χ and its contact point cos(π − β) = −κ
+        flipped = tuple((g, c_, tuple((m, value if m % 2 else -value) for m, value in powers))
+                        for g, c_, powers in state.elements)
+        polynomial = (tuple(-x for x in state.load), state.rank_one, flipped)
+        return None, VectorArc(rows, mode, tuple(-x for x in chi), tuple(-g for g in forcing_columns[i]), -spring.kappa,
+                               exponent, coefficient, polynomial, digits)
 
     branch_system = assemble({})
     crossed = {}

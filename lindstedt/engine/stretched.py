@@ -369,10 +369,12 @@ class StretchedArc:
 
 
 class VectorArc:
-    """The release-side contact arc of an N-dof NNM with one fractional-power element (Hertz), on a fixed interval.
+    """A contact arc of an N-dof NNM with one fractional-power element (Hertz), on a fixed interval.
 
     The modal normal form (:mod:`lindstedt.engine.modal`) on the first piece ``s ∈ [0, s*(ε̂))``, where element i
-    is in contact, in stretched time ``τ = s/s*``, ``Y_k(τ) = W_k(s* τ)``, ``μ = Ω²/s*²``::
+    is in contact, in stretched time ``τ = s/s*``, ``Y_k(τ) = W_k(s* τ)``, ``μ = Ω²/s*²`` (the last piece, contact
+    around the far turning point, is the same problem in ``Y = −W``, ``τ = (π − s)/(π − s_L*)``, with the laws
+    ``−F(−Y)``: its h_k are all unknown)::
 
         μ Y_k'' + r_k² Y_k + ε̂ F_k(Y) = 0,    Y_k'(0) = 0,    χ·Y(1) = κ χ_j (the contact point stays at τ = 1),
 
