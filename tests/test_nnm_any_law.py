@@ -188,3 +188,49 @@ def test_the_cli_shoots_the_nnm_of_a_system_file_with_laws(tmp_path, capsys):
     result = json.loads(capsys.readouterr().out)
     assert result["success"]
     assert result["frequency"] == pytest.approx(_duffing_frequency(3.0, 9 * 0.3, 1 / math.sqrt(2)), rel=RTOL)
+
+
+@pytest.mark.parametrize("laws", [["Max(0, u - 1/5) - Max(0, -u - 1/5)"], ["2*Max(0, u - 1/10) + 3*Max(0, u - 1/2)"],
+                                  ["u/2 + Max(0, u)/2"], ["Min(0, u)"], ["u + 1"]])
+def test_continuous_piecewise_linear_laws_are_sums_of_unilateral_springs(laws):
+    """ramp_equivalent: the same forces with unilateral springs only (checked at random states, both written out)."""
+    system = UnilateralSystem(M=[[1, 0], [0, 2]], K=[[3, -1], [-1, 2]], A=[[1, -1]], b=["1/10"], W=[[2], [-1]],
+                              laws=laws)
+    equivalent, elements = system.ramp_equivalent
+    assert equivalent.unilateral and set(elements) == {0}
+    positions = np.random.default_rng(7).normal(size=(40, 2))
+    np.testing.assert_allclose(equivalent.acceleration(positions, 0.7), system.acceleration(positions, 0.7),
+                               rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("laws", [["Heaviside(u)"], ["Max(0, u)**2"], ["u**3"], ["Max(0, u) + 1"]])
+def test_laws_that_are_not_sums_of_springs_have_no_ramp_form(laws):
+    system = UnilateralSystem(M=[[1]], K=[[1]], A=[[1]], laws=laws)  # a jump, a curve, a constant load
+    assert system.ramp_equivalent is None
+
+
+@pytest.mark.parametrize("epsilon", [0.3, 2.0])
+def test_a_dead_zone_is_shot_on_the_exact_flow_to_its_closed_form_period(epsilon):
+    """x'' + x + ε [(x − g)_+ − (−x − g)_+] = 0 from rest at a > g: about x* = εg/(1 + ε) at ω = √(1 + ε) until
+    x = g (time t1), then free to x = 0 (time t2): T = 4 (t1 + t2) (the law is odd)."""
+    g, a = 0.2, 1.0
+    system = UnilateralSystem(M=[[1]], K=[[1]], A=[[1]], laws=["Max(0, u - 1/5) - Max(0, -u - 1/5)"])
+    orbit = nnm_point(system, epsilon, 1, modal_amplitude=a)
+    assert orbit.success, orbit.message
+    omega, centre = math.sqrt(1 + epsilon), epsilon * g / (1 + epsilon)
+    t1 = math.acos((g - centre) / (a - centre)) / omega
+    speed = (a - centre) * omega * math.sin(omega * t1)
+    period = 4 * (t1 + math.atan(g / speed))
+    assert orbit.period == pytest.approx(period, rel=1e-13)  # the exact flow: rounding only (DOP853: ~1e-13)
+    assert orbit.n_switches == 4 and orbit.contact_springs == (0,)
+
+
+def test_a_forced_system_with_a_dead_zone_runs_on_the_exact_flow():
+    from lindstedt import ForcedSystem
+    from lindstedt.numerics import forced_flow
+
+    system = UnilateralSystem(M=[[1, 0], [0, 2]], K=[[3, -1], [-1, 2]], A=[[1, -1]],
+                              laws=["Max(0, u - 1/5) - Max(0, -u - 1/5)"])
+    assert type(forced_flow(ForcedSystem(system, [1, 0], rayleigh=(0, "1/50")), 0.5)).__name__ == "ForcedFlow"
+    assert type(forced_flow(ForcedSystem(UnilateralSystem(M=[[1]], K=[[1]], A=[[1]], laws=["u**3"]), [1]), 0.5)
+                ).__name__ == "SmoothForcedFlow"

@@ -67,8 +67,10 @@ def _description(flow: Any) -> Any:
 def forced_flow(problem: ForcedOscillator | ForcedSystem, epsilon: float) -> PeriodMap:
     """The flow that computes ``problem``'s responses: exact where it can be, DOP853 elsewhere.
 
-    A :class:`~lindstedt.ForcedSystem` of unilateral springs, or a :class:`~lindstedt.ForcedOscillator` whose f
-    is piecewise linear (unilateral springs, gaps, jumps), gets the exact event-driven
+    A :class:`~lindstedt.ForcedSystem` of unilateral springs or of continuous piecewise-linear laws that vanish at
+    a breakpoint (gaps, stops, dead zones: :attr:`UnilateralSystem.ramp_equivalent`), or a
+    :class:`~lindstedt.ForcedOscillator` whose f is piecewise linear (unilateral springs, gaps, jumps), gets the exact
+    event-driven
     :class:`~lindstedt.numerics.ForcedFlow`; any other law (u³, Hertz contact, …, on one degree of freedom or on
     the elements of a system) the DOP853 flow with variational equations
     :class:`~lindstedt.numerics.SmoothForcedFlow`.
@@ -86,7 +88,13 @@ def forced_flow(problem: ForcedOscillator | ForcedSystem, epsilon: float) -> Per
     from .forced_smooth import SmoothForcedFlow
 
     if isinstance(problem, ForcedSystem):
-        return ForcedFlow(problem, epsilon) if problem.system.unilateral else SmoothForcedFlow(problem, epsilon)
+        exact = problem.system.ramp_equivalent  # continuous piecewise-linear laws are sums of unilateral springs
+        if exact is None:
+            return SmoothForcedFlow(problem, epsilon)
+        if exact[0] is not problem.system:  # the same forced problem on the springs' form of the laws
+            problem = ForcedSystem(exact[0], problem.P_exact,
+                                   C=problem.C_exact if problem.C_exact is not None else problem.C.tolist())
+        return ForcedFlow(problem, epsilon)
     if not isinstance(problem, ForcedOscillator):
         raise ProblemError(f"expected a ForcedOscillator or a ForcedSystem, got {type(problem).__name__}")
     try:

@@ -352,15 +352,17 @@ class NNMShooting:
         if flow is None:
             if len(self._flows) > 8:
                 self._flows.clear()
-            kind = ExactFlow if self.system.unilateral else SmoothForcedFlow
-            flow = self._flows[epsilon] = kind(self.system, epsilon)
+            exact = self.system.ramp_equivalent  # unilateral springs, or continuous piecewise-linear laws as ramps
+            flow = self._flows[epsilon] = (ExactFlow(exact[0], epsilon) if exact is not None
+                                           else SmoothForcedFlow(self.system, epsilon))
         return flow
 
     def equilibrium(self, epsilon: float) -> np.ndarray:
         """The static equilibrium about which the NNMs oscillate: active sets for unilateral springs, the core
         Newton from X = 0 on the elements' laws otherwise (:meth:`SmoothForcedFlow.static_equilibrium`)."""
-        if self.system.unilateral:
-            return _unilateral_equilibrium(self.system, epsilon)
+        exact = self.system.ramp_equivalent
+        if exact is not None:
+            return _unilateral_equilibrium(exact[0], epsilon)
         return self._flow(epsilon).static_equilibrium()
 
     def initial_guess(self, epsilon: float) -> np.ndarray:
@@ -513,7 +515,8 @@ class NNMShooting:
         >>> bool(problem.shortest_period(3.0) == np.pi)   # κ = 1 + 3: L = 2; the bilinear orbit has T = 3π/2
         True
         """
-        system = self.system
+        exact = self.system.ramp_equivalent
+        system = exact[0] if exact is not None and slopes is None else self.system
         stiffness = float(np.linalg.norm(np.linalg.solve(system.M, system.K), 2))
         if system.n_springs and epsilon != 0:
             steepest = np.ones(system.n_springs) if slopes is None else np.abs(np.asarray(slopes, dtype=float))
@@ -587,7 +590,7 @@ class NNMShooting:
         x0, v0, period = self.split(unknowns)
         if not (math.isfinite(period) and period > 0):
             return self._failure(epsilon, f"invalid period T = {period}", iterations, label=label, x0=x0)
-        shortest = self.shortest_period(epsilon) if self.system.unilateral else 0.0
+        shortest = self.shortest_period(epsilon) if self.system.ramp_equivalent is not None else 0.0
         if period < shortest:
             return self._collapse(epsilon, period, shortest, note, iterations, label, x0)
         self.flow_evaluations += 1
@@ -673,8 +676,9 @@ class NNMShooting:
             run = flow._run(x0, v0, period, dense=True, sensitivity=True)
             if not run["success"]:
                 raise ConvergenceError(run["message"])
+            elements = self.system.ramp_equivalent[1]  # the element each spring of the exact flow comes from
             return _Run(np.r_[run["x"], run["v"]], run["jacobian"], len(run["events"]),
-                        tuple(sorted({event.spring for event in run["events"]})), lambda t: _state_at(run, t))
+                        tuple(sorted({elements[event.spring] for event in run["events"]})), lambda t: _state_at(run, t))
         fractions = {period * k / _SAMPLES for k in range(_SAMPLES)} | \
             {period / m for m in range(2, _PROBED_REPETITIONS + 1)}
         times = np.array(sorted(fractions))

@@ -259,6 +259,71 @@ class UnilateralSystem:
         """True when every element is a unilateral spring ``Max(0, u)`` (the exact flow's problem)."""
         return all(law == UNILATERAL for law in self.laws)
 
+    @cached_property
+    def ramp_equivalent(self) -> tuple["UnilateralSystem", tuple[int, ...]] | None:
+        """The same system written with unilateral springs only, where every law is continuous and piecewise linear
+        and vanishes at its first breakpoint (gaps, stops, dead zones, multi-stage springs); None otherwise.
+
+        Such a law is a sum of ramps: with p_1 its first breakpoint, β its slope before p_1 and d_k its slope jumps,
+        ``f(u) = −β (p_1 − u)_+ + Σ_k s_k (u − p_k)_+`` (s_1 = β + d_1, s_k = d_k), exactly, when ``f(p_1) = 0``; a
+        linear law ``β (u − p)`` with a root p is ``β (u − p)_+ − β (p − u)_+``.  Each ramp of element i becomes the
+        spring ``(±a_iᵀX ∓ (b_i + p))_+`` with force column ``weight · w_i``.  The exact event-driven flows run on it.
+
+        Returns
+        -------
+        (UnilateralSystem, tuple of int) or None
+            The equivalent system and, for each of its springs, the element it comes from.
+
+        Examples
+        --------
+        A dead zone of width 1/5 at mass 1: two springs, one on each side.
+
+        >>> system = UnilateralSystem(M=[[1]], K=[[1]], A=[[1]], laws=["Max(0, u - 1/5) - Max(0, -u - 1/5)"])
+        >>> equivalent, elements = system.ramp_equivalent
+        >>> equivalent.A.tolist(), equivalent.b.tolist(), equivalent.W.tolist(), elements
+        ([[-1.0], [1.0]], [0.2, 0.2], [[-1.0, 1.0]], (0, 0))
+        """
+        from .piecewise_linear import decompose_piecewise, has_non_polynomial_law
+
+        if self.unilateral:
+            return self, tuple(range(self.n_springs))
+        rows, offsets, columns, origin = [], [], [], []
+        for i, law in enumerate(self.laws):
+            if has_non_polynomial_law(law, LAW_VARIABLE):
+                return None
+            try:
+                intervals = decompose_piecewise(law, LAW_VARIABLE, max_degree=1)
+            except (ProblemError, UnsupportedNonlinearityError):
+                return None
+            pieces = [(interval.coefficients[0], interval.coefficients[1] if len(interval.coefficients) > 1 else 0)
+                      for interval in intervals]
+            points = [interval.upper for interval in intervals[:-1]]
+            if not points:  # linear: β (u − p) with its root p
+                intercept, slope = pieces[0]
+                if slope == 0:
+                    return None
+                points, pieces = [-intercept / slope], pieces * 2
+            for point, (c_left, s_left), (c_right, s_right) in zip(points, pieces, pieces[1:]):
+                if sympy.simplify(c_left + s_left * point - (c_right + s_right * point)) != 0:
+                    return None  # a jump: not a sum of ramps
+            intercept, slope = pieces[0]
+            if sympy.simplify(intercept + slope * points[0]) != 0:
+                return None  # f(p_1) ≠ 0: a constant load, not a spring
+            a, b, w = self.A_exact.row(i), self.b_exact[i, 0], self.W_exact.col(i)
+            # −β (p_1 − u)_+, then at p_1 the slope right of it, at every later p_k the slope's jump
+            ramps = [(-1, points[0], -slope), (1, points[0], pieces[1][1])]
+            ramps += [(1, point, right[1] - left[1]) for point, left, right in zip(points[1:], pieces[1:], pieces[2:])]
+            for side, point, weight in ramps:
+                if weight != 0:
+                    rows.append([side * entry for entry in a])
+                    offsets.append(side * (b + point))
+                    columns.append([weight * entry for entry in w])
+                    origin.append(i)
+        if not rows:
+            return None
+        W = [[column[r] for column in columns] for r in range(self.n_dof)]
+        return UnilateralSystem(M=self.M_exact.tolist(), K=self.K_exact.tolist(), A=rows, b=offsets, W=W), tuple(origin)
+
     def require_unilateral(self, what: str) -> None:
         """Raise :class:`~lindstedt.UnsupportedNonlinearityError` naming ``what`` unless every element is a
         unilateral spring.
