@@ -32,6 +32,7 @@ NAMES = (
     "fig4_8_numerical_nnm.ipynb",
     "forced_response.ipynb",
     "hertz_backbone.ipynb",
+    "nnm_any_law.ipynb",
     "peer_nlvib02.ipynb",
     "peer_nlvib03.ipynb",
     "peer_sdnd123.ipynb",
@@ -58,6 +59,7 @@ PLOT_FUNCTIONS = {
     "peer_sdnd123.ipynb": {"branch"},
     "peer_nlvib02.ipynb": {"frequency_response"},
     "peer_nlvib03.ipynb": {"frequency_response"},
+    "nnm_any_law.ipynb": {"branch"},
 }
 #: the figures (image/png outputs) each executed notebook shows, at least
 FIGURES = {
@@ -72,6 +74,7 @@ FIGURES = {
     "peer_sdnd123.ipynb": 1,
     "peer_nlvib02.ipynb": 3,
     "peer_nlvib03.ipynb": 3,
+    "nnm_any_law.ipynb": 3,
 }
 #: rich displays of results (the last expression of a cell): (mime type, fragments that one such output contains)
 DISPLAYS = {
@@ -98,6 +101,11 @@ DISPLAYS = {
     "hertz_backbone.ipynb": [
         ("text/latex", ["Stretched contact arc", r"|u - b|^{3/2}"]),
         ("text/html", ['<table class="lindstedt">', "<b>StretchedArcSeries"]),
+    ],
+    # NNMExpansion._repr_latex_ of the 3-mass chain's mode 1 to order 3, and the continued NNMBranch
+    "nnm_any_law.ipynb": [
+        ("text/latex", [r"\lambda_{1} &=", r"\omega_{3} &=", r"a_{3} &="]),
+        ("text/html", ['<table class="lindstedt">', "<b>NNMBranch: "]),
     ],
 }
 
@@ -155,7 +163,7 @@ def _client_modules():
 
 #: notebooks taking 5–20 s each: executed by `pytest -m slow` (CI runs it) and by every build of the docs site
 HEAVY = ("backbone.ipynb", "hertz_backbone.ipynb", "peer_sdnd123.ipynb", "peer_nlvib02.ipynb",
-         "peer_nlvib03.ipynb")
+         "peer_nlvib03.ipynb", "nnm_any_law.ipynb")
 
 
 @pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.slow) if name in HEAVY else name for name in NAMES])
