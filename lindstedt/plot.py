@@ -416,11 +416,18 @@ def nnm_orbit(point: Any, *, dofs: tuple[int, int] = (0, 1), samples: int = 512,
     if axes is None:
         _, axes = _pyplot().subplots(1, 2, figsize=(10, 4))
     orbit, lines = axes
-    flow = lindstedt.ExactFlow(point.system, point.epsilon).solve(point.release_position, point.release_velocity, point.period)
-    if not flow.success:
-        raise LindstedtError(f"the exact flow failed: {flow.message}")
     times = np.linspace(0.0, point.period, samples, endpoint=False)
-    positions, _ = flow.state(times)
+    exact = point.system.ramp_equivalent  # unilateral springs or piecewise-linear laws: the exact flow
+    if exact is not None:
+        flow = lindstedt.ExactFlow(exact[0], point.epsilon).solve(point.release_position, point.release_velocity,
+                                                                   point.period)
+        if not flow.success:
+            raise LindstedtError(f"the exact flow failed: {flow.message}")
+        positions, _ = flow.state(times)
+    else:  # any other law: DOP853, sampled in the same run
+        _, states, _ = lindstedt.numerics.SmoothForcedFlow(point.system, point.epsilon).run(
+            np.r_[point.release_position, point.release_velocity], point.period, times)
+        positions = states[:, :point.system.n_dof]
     first, second = dofs
     orbit.plot(positions[:, first], positions[:, second], label=f"mode {point.mode}, ε = {point.epsilon:g}")
     orbit.set_xlabel(f"$X_{{{first + 1}}}$")

