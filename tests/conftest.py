@@ -12,3 +12,26 @@ except ImportError:  # the property tests import it themselves and say so
 else:
     settings.register_profile("lindstedt", deadline=None, suppress_health_check=[HealthCheck.too_slow])
     settings.load_profile("lindstedt")
+
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+
+@pytest.fixture
+def slope_against_shooting():
+    """``slope(system, mode, a0, order=2)``: the NNM expansion's frequency error against Newton shooting
+    (:func:`lindstedt.nnm_point`, the reference) at ε = 1e-2 … 1e-3, and its fitted log-log slope (order + 1 when
+    the expansion is right); returns (slope, errors)."""
+    import lindstedt
+
+    def slope(system, mode, a0, order=2, epsilons=np.geomspace(1e-2, 1e-3, 4)):
+        expansion = lindstedt.nnm(system, mode, a0=a0, order=order)
+        errors = []
+        for epsilon in epsilons:
+            orbit = lindstedt.nnm_point(system, epsilon, mode, modal_amplitude=float(a0))
+            assert orbit.success, orbit.message
+            errors.append(abs(float(expansion.frequency(epsilon)) - orbit.frequency))
+        return float(np.polyfit(np.log(epsilons), np.log(errors), 1)[0]), errors
+
+    return slope

@@ -67,6 +67,22 @@ _MAXIMUM_NODES = 1024
 _GUARD_DIGITS = 20
 
 
+def _resolved(arc: Any, order: int, tail_of: Callable[[Any], Any]) -> Any:
+    """The next order's particular data of an arc (:class:`StretchedArc` or :class:`VectorArc`), the Chebyshev grid
+    doubled until its tail (``tail_of``) and the fixed orders' are below the working precision; kept as pending."""
+    if order != len(arc._mu):
+        raise ValueError(f"order {order} of the stretched arc is not the next one ({len(arc._mu)})")
+    tolerance = mpmath.mpf(10) ** (-(arc.digits + 2))
+    while True:
+        with workdps(arc._working):
+            data = arc._particular(order)
+        if max(tail_of(data), arc.tail) <= tolerance:
+            break
+        arc._refine(order)
+    arc._pending = (order, data)
+    return data
+
+
 class _FixedPointTransform:
     """``y = T x`` (or ``Tᵀ x``) for the arc's Chebyshev matrix ``T_{k,i} = cos(k θ_i)`` in fixed point: T and x as
     Python integers scaled by 2^bits (x relative to its largest entry), one integer matrix product (numpy object
@@ -326,16 +342,7 @@ class StretchedArc:
         Orders below ``order`` must be fixed (:meth:`fix`); the Chebyshev grid is refined until
         the order's forcing is resolved to the working precision.
         """
-        if order != len(self._mu):
-            raise ValueError(f"order {order} of the stretched arc is not the next one ({len(self._mu)})")
-        tolerance = mpmath.mpf(10) ** (-(self.digits + 2))
-        while True:
-            with workdps(self._working):
-                data = self._particular(order)
-            if max(data["tail"], self.tail) <= tolerance:
-                break
-            self._refine(order)
-        self._pending = (order, data)
+        data = _resolved(self, order, lambda data: data["tail"])
         with workdps(self._working):
             return self._response(data)
 
@@ -598,16 +605,7 @@ class VectorArc:
         The whole end value is ``P_k(1) + h_k cos(β r_k) [+ (β³ μ/2) sin β for k = j]``, the slope
         ``P_k'(1) − h_k β r_k sin(β r_k) [+ (β³ μ/2)(sin β + β cos β)]`` (:meth:`end_terms`).
         """
-        if order != len(self._mu):
-            raise ValueError(f"order {order} of the stretched arc is not the next one ({len(self._mu)})")
-        tolerance = mpmath.mpf(10) ** (-(self.digits + 2))
-        while True:
-            with workdps(self._working):
-                data = self._particular(order)
-            if max(max(item["tail"] for item in data), self.tail) <= tolerance:
-                break
-            self._refine(order)
-        self._pending = (order, data)
+        data = _resolved(self, order, lambda data: max(item["tail"] for item in data))
         return [(item["end"], item["end_slope"]) for item in data]
 
     @locked
