@@ -45,6 +45,7 @@ def _steady_state(rtol: float, periods: int) -> np.ndarray:
     return solve_ivp(rhs, (0.0, end), np.zeros(4), method="DOP853", rtol=rtol, atol=rtol * 1e-2).y[:, -1]
 
 
+@pytest.mark.slow  # two 600-period reference integrations (5 s)
 def test_a_cubic_element_forced_orbit_is_the_steady_state_of_the_ode():
     orbit = forced_periodic_orbit(_cubic_chain(), OMEGA, epsilon=EPSILON)
     assert orbit.success and orbit.stable, orbit.message

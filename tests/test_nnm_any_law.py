@@ -148,6 +148,7 @@ def test_a_prestressed_element_oscillates_about_its_static_equilibrium():
     assert orbit.period == pytest.approx(_energy_integral_period(potential, release, 0.0), rel=RTOL)
 
 
+@pytest.mark.slow  # a continuation and two long DOP853 runs (3 s)
 def test_an_orbit_of_a_system_without_reduction_closes_under_an_independent_integration():
     """Three masses, a cubic spring between masses 1 and 2 and a Hertz contact at mass 3 with a gap."""
     M = np.diag([1.0, 2.0, 1.0])
