@@ -42,6 +42,7 @@ REGISTRY: dict[str, tuple[str, str]] = {
     "performance": ("bench_performance", "run"),
     "forced": ("bench_forced", "run"),
     "orbit-core": ("bench_orbit_core", "run"),
+    "structures": ("bench_structures", "run"),
 }
 
 
