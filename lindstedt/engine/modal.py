@@ -198,7 +198,9 @@ def _small_divisors(ratios: list[Any], mode: int) -> tuple[tuple[int, int, Any],
         if k == mode:
             continue
         nearest = int(mpmath.nint(ratio))
-        if abs(ratio - nearest) < _RESONANCE_TOLERANCE * max(1, abs(ratio)):
+        # absolute: the divisor is |r² − n²| ≈ 2n|r − n|, so a high mode within 4e-4 of its harmonic 1.6e6 (a beam's
+        # at 801 dof) divides by 1250, not by a small number (a relative test called it a resonance)
+        if abs(ratio - nearest) < _RESONANCE_TOLERANCE:
             raise ResonanceError(
                 f"internal resonance: lambda_{k + 1}/lambda_{mode + 1} = {mpmath.nstr(ratio, 12)} is the harmonic "
                 f"{nearest} of mode {mode + 1}; the strained-coordinates NNM of mode {mode + 1} does not exist "

@@ -197,8 +197,8 @@ def _refined_modes(system: _ExactSystem, digits: int) -> _RefinedModes | None:
 
     Fixed-point arithmetic on Python ints (X = ints · 2^-p): the residual of every mode is formed exactly
     from the band of K and M (integer entries exactly, others to 2^-(p+64)), rounded to float64 and
-    projected on the float modes.  None when a relative gap between the θ_k is below 1e-9 or the sweeps
-    do not converge (the caller then decomposes densely in mpmath).
+    projected on the float modes.  None when two θ_k coincide, when a sweep would gain fewer than 4 bits
+    (``log2(θ_max/gap) > 44``) or the sweeps do not converge (the caller then decomposes densely in mpmath).
     """
     frequencies, shapes = system.modes()
     theta_float = frequencies**2
@@ -207,8 +207,10 @@ def _refined_modes(system: _ExactSystem, digits: int) -> _RefinedModes | None:
     gaps = theta_float[:, None] - theta_float[None, :]
     np.fill_diagonal(gaps, np.inf)
     smallest_gap = float(np.min(np.abs(gaps))) if n > 1 else largest
-    if smallest_gap < 1e-9 * largest:
+    if not smallest_gap > 0:  # a repeated frequency: the sweeps cannot separate it
         return None
+    # a sweep gains the float residual's 52 bits less log2(θ_max/gap): the only test of convergence needed (a test
+    # of the gap against 1e-9 θ_max refused beams past ~200 dof, whose θ_max grows like n⁴, at 18 bits a sweep)
     conditioning = np.log2(largest / smallest_gap)
     gain = 52 - conditioning - 4  # bits gained per sweep
     if gain < 4:
