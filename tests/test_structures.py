@@ -393,3 +393,17 @@ def test_read_matrices_refuses_bad_arguments(tmp_path):
         read_matrices({"M": tmp_path / "M.mtx", "Q": tmp_path / "Q.mtx"})
     with pytest.raises(ProblemError, match="no file is given for K"):
         read_matrices({"M": tmp_path / "M.mtx"})
+
+
+@pytest.mark.parametrize("elements", [112, pytest.param(400, marks=pytest.mark.slow)])  # 225, 801 dof; crack at L/4
+def test_the_nnm_of_a_fine_cracked_beam_starts_from_the_continuous_beams_frequency(elements):
+    """Past ~200 dof the modal refinement refused beams (θ_max grows like n⁴) and, at 801 dof, a mode within 4e-4 of
+    its harmonic 1.6e6 was called an internal resonance: the order-2 NNM of the first mode now runs, and its ω₀ is
+    the continuous cracked cantilever's λ₁ = β₁² (exact determinant) to the FE error (βh)⁴/1440."""
+    import lindstedt
+
+    beta = _cracked_cantilever(0.25, 10.0, 1)[0]
+    expansion = lindstedt.nnm(EulerBernoulliBeam(elements, cracks=[(elements // 4, 10)]).system(), 1, a0=1, order=2)
+    error = float(expansion.omega[0]) / beta**2 - 1
+    assert 0 < error < 2 * _leading_error(beta, elements) + 1e-13  # the FE error from above, plus the root's 1e-15
+    assert len(expansion.omega) == 3 and all(np.isfinite(float(w)) for w in expansion.omega)
