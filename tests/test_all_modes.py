@@ -45,6 +45,7 @@ def _spectral_peak(signal, times, guess):
     return search.x
 
 
+@pytest.mark.slow  # long exact-flow simulations of every mode (6 s)
 def test_frequency_shifts_match_simulation_of_the_exact_flow():
     system = UnilateralSystem.chain(3, unilateral=[(0, 0.3), (2, -0.2)])
     amplitudes = np.array([1.0, 0.5, 0.3])

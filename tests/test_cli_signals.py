@@ -131,6 +131,7 @@ def test_without_a_terminal_a_long_command_prints_one_summary_line():
     assert [b["kind"] for b in data["bifurcations"]] == ["fold", "fold"]
 
 
+@pytest.mark.slow  # three CLI runs, one a high order (9 s)
 def test_summaries_of_nnm_shooting_and_high_orders_and_silence_below(capsys):
     chain = str(Path(__file__).resolve().parents[1] / "examples" / "chain2.json")
     assert main(["nnm", chain, "--mode", "1", "--numeric", "--energy", "1", "--eps", "1", "--format", "json"]) == 0

@@ -163,7 +163,9 @@ def _client_modules():
 
 #: notebooks taking 5–20 s each: executed by `pytest -m slow` (CI runs it) and by every build of the docs site
 HEAVY = ("backbone.ipynb", "hertz_backbone.ipynb", "peer_sdnd123.ipynb", "peer_nlvib02.ipynb",
-         "peer_nlvib03.ipynb", "nnm_any_law.ipynb")
+         "peer_nlvib03.ipynb", "nnm_any_law.ipynb",
+         # 4–5 s each: the default run stays near five minutes (the slow run executes them)
+         "fig4_8_numerical_nnm.ipynb", "forced_response.ipynb", "validity_time.ipynb", "runtime_vs_error.ipynb")
 
 
 @pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.slow) if name in HEAVY else name for name in NAMES])

@@ -395,7 +395,8 @@ def test_read_matrices_refuses_bad_arguments(tmp_path):
         read_matrices({"M": tmp_path / "M.mtx"})
 
 
-@pytest.mark.parametrize("elements", [112, pytest.param(400, marks=pytest.mark.slow)])  # 225, 801 dof; crack at L/4
+@pytest.mark.parametrize("elements", [pytest.param(112, marks=pytest.mark.slow), pytest.param(400, marks=pytest.mark.slow)])
+# 225 and 801 dof (3 s and 25 s), the crack at L/4
 def test_the_nnm_of_a_fine_cracked_beam_starts_from_the_continuous_beams_frequency(elements):
     """Past ~200 dof the modal refinement refused beams (θ_max grows like n⁴) and, at 801 dof, a mode within 4e-4 of
     its harmonic 1.6e6 was called an internal resonance: the order-2 NNM of the first mode now runs, and its ω₀ is
