@@ -288,8 +288,9 @@ def test_a_full_output_device_is_one_error_line():
 
 @pytest.mark.parametrize("arguments", [
     ["derive", "duffing", "--order", "2", "--output", "{blocker}/sub"],
-    ["demo", "--order", "2", "--figure", "{blocker}/x.png"],
-    ["forced", "u**3", "--eps", "0.1", "--from", "0.9", "--to", "1.1", "--figure", "{blocker}/x.png"],
+    pytest.param(["demo", "--order", "2", "--figure", "{blocker}/x.png"], marks=pytest.mark.slow),  # 5 s each
+    pytest.param(["forced", "u**3", "--eps", "0.1", "--from", "0.9", "--to", "1.1", "--figure", "{blocker}/x.png"],
+                 marks=pytest.mark.slow),
 ])
 def test_an_unwritable_output_path_is_one_error_line(tmp_path, arguments):
     # a path under a regular file can be written by nobody, root included

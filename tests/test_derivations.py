@@ -297,6 +297,7 @@ def test_all_modes_zero_gap_corrections_equal_the_closed_form(results):
 # --------------------------------------------------------------------------- #
 # the scripts
 # --------------------------------------------------------------------------- #
+@pytest.mark.slow  # every derivation script as a subprocess from two directories (10–15 s); in-process they run in the default run (test_render)
 def test_every_script_runs_from_any_directory_and_prints_its_coefficients_checks_and_files(tmp_path):
     processes = {}
     for name in NAMES:
