@@ -179,3 +179,14 @@ def test_the_waveform_with_a_gap_and_a_cubic_spring_is_right_at_its_order():
               for epsilon in epsilons]
     slope = np.polyfit(np.log(epsilons), np.log(errors), 1)[0]
     assert 2.7 <= slope <= 3.3, errors
+
+
+def test_the_validity_check_s_extra_order_is_priced_before_it_runs():
+    """frequency() derives ω_{n+1} for its warning: that order is priced like any request (BudgetError above the
+    budget in force, naming the check), then computed once the budget allows it."""
+    import lindstedt.limits
+
+    expansion = lindstedt.nnm(UnilateralSystem.chain(20, unilateral=[(0, "1/10")]), 1, a0=1, order=2)
+    with lindstedt.limits.budget(seconds=1e-6), pytest.raises(lindstedt.BudgetError, match="validity check.*order 3"):
+        expansion.frequency(0.01)
+    assert np.isfinite(expansion.frequency(0.01))

@@ -226,7 +226,17 @@ class NNMExpansion:
 
     @cached_property
     def _coefficients(self) -> np.ndarray:
-        """ω_0 … ω_n and the next coefficient ω_{n+1} (derived on first use: order n + 1 of the hierarchy), as floats."""
+        """ω_0 … ω_n and the next coefficient ω_{n+1} (derived on first use: order n + 1 of the hierarchy, priced by
+        the NNM cost model and refused above the budget, :class:`~lindstedt.BudgetError`), as floats."""
+        from dataclasses import replace
+
+        from .._cost import nnm_estimate
+
+        # priced like any request: the next order is the check's own work (140 s against the expansion's 7 s on a
+        # 1000-dof chain), refused above the budget in force rather than spent unannounced
+        estimate = nnm_estimate(self.system, self.mode, self.order + 1)
+        replace(estimate, task=f"the validity check of this expansion (its order {self.order + 1}: "
+                               f"{estimate.task})").check()
         lam = self.omega[0]
         steps = self.gauge
         index = steps * self.order + 1
