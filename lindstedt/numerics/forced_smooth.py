@@ -403,28 +403,28 @@ class SmoothForcedFlow:
         if affine is not None:  # every piece affine (unilateral springs): one matrix for the whole region
             Km, offset = self._Km + eps * affine[0], eps * affine[1]
 
-            def restoring(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-                return Km @ x - offset, Km
+            def restoring(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+                return Km @ x - offset, Km, None
 
-            def nonlinear(x: np.ndarray) -> np.ndarray:
+            def nonlinear(x: np.ndarray) -> np.ndarray:  # only for the ∂/∂ε column
                 return affine[0] @ x - affine[1]
         else:  # the laws' analytic pieces: M⁻¹(K X + ε Σ_i w_i f_i(u_i)) and its Jacobian K + ε Σ_i w_i f_i'(u_i) a_iᵀ
             pieces = [law.pieces[r] for law, r in zip(elements.laws, region)]
             A, b, MW, K = elements.A, elements.b, elements.MW, self._Km
 
-            def restoring(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            def restoring(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+                """(M⁻¹ × the restoring force, its Jacobian, M⁻¹ Σ_i w_i f_i — the laws evaluated once)."""
                 u = A @ x - b
-                forces = np.array([value(ui) for (value, _, _), ui in zip(pieces, u)])
+                forces = MW @ np.array([value(ui) for (value, _, _), ui in zip(pieces, u)])
                 slopes = np.array([slope(ui) for (_, slope, _), ui in zip(pieces, u)])
-                return K @ x + eps * (MW @ forces), K + eps * (MW * slopes) @ A
+                return K @ x + eps * forces, K + eps * (MW * slopes) @ A, forces
 
-            def nonlinear(x: np.ndarray) -> np.ndarray:
-                return MW @ np.array([value(ui) for (value, _, _), ui in zip(pieces, A @ x - b)])
+            nonlinear = None
 
         def system(t: float, y: np.ndarray) -> np.ndarray:
             x, v = y[:n], y[n:2 * n]
             phase = frequency * t
-            force, tangent = restoring(x)
+            force, tangent, laws = restoring(x)
             a = eps * scale * math.cos(phase) * Pm - force - Cm @ v
             if not sensitivity:
                 return np.concatenate((v, a))
@@ -434,7 +434,7 @@ class SmoothForcedFlow:
             dY[n:] = -tangent @ Y[:n] - Cm @ Y[n:]
             dY[n:, 2 * n] -= eps * scale * t * math.sin(phase) * Pm
             if epsilon_column:
-                dY[n:, 2 * n + 1] += scale * math.cos(phase) * Pm - nonlinear(x)
+                dY[n:, 2 * n + 1] += scale * math.cos(phase) * Pm - (laws if laws is not None else nonlinear(x))
             else:
                 dY[n:, 2 * n + 1] += eps * math.cos(phase) * Pm
             return np.concatenate((v, a, dY.reshape(-1)))

@@ -8,7 +8,8 @@ and a Newton (Gauss–Newton) iteration whose Jacobian is exact — the state
 transition matrix of the flow over T/2 or T (over a full period: the monodromy
 matrix), the vector field at the end point for the derivative in T, and the
 derivative in ε.  No finite differences are used.  Where every element is a
-unilateral spring ``f_i = (·)_+`` the flow is the exact piecewise closed form
+unilateral spring ``f_i = (·)_+``, or a continuous piecewise-linear law written as such springs
+(:attr:`UnilateralSystem.ramp_equivalent`), the flow is the exact piecewise closed form
 (:class:`lindstedt.numerics.ExactFlow`, its ∂/∂ε a closed-form Duhamel integral,
 :mod:`lindstedt.numerics.sensitivity`); for any other law (``u**3``, a Hertz
 contact ``Max(0, u)**(3/2)``, a gap with a jump …) it is DOP853 with its
@@ -347,7 +348,8 @@ class NNMShooting:
 
     # ------------------------------------------------------------------ pieces
     def _flow(self, epsilon: float) -> ExactFlow | SmoothForcedFlow:
-        """The flow at ε: exact for unilateral springs, DOP853 with variational equations for any other law."""
+        """The flow at ε: exact for unilateral springs and their ramp sums, DOP853 with variational equations for any
+        other law."""
         flow = self._flows.get(epsilon)
         if flow is None:
             if len(self._flows) > 8:
