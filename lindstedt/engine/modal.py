@@ -292,9 +292,11 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
 
     analytic_elements: dict[tuple[int, int], _AnalyticElement] = {}
 
+    crossed_elements = {spring.element for spring in springs if spring.status in ("crossing", "grazing")}
+
     def moved_across(i: int) -> bool:
         """Whether the orbit crosses (or grazes) a breakpoint of element i's law."""
-        return any(spring.element == i and spring.status in ("crossing", "grazing") for spring in springs)
+        return i in crossed_elements
 
     def analytic_element(i: int, interval: int) -> _AnalyticElement:
         """Element i's analytic part on one interval of its law; the deformation must stay inside the interval
@@ -347,10 +349,11 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
             cosine = middle.context.cos(middle)
             load = [domain.zero] * size
             rank_one, elements, analytic = [], [], []
+            flipped_springs = [springs[index] for index in flips]  # the grazed breakpoints this piece lies beyond
             for i, law in enumerate(laws):
                 interval = law.interval(a0 * B[i][mode] * cosine - gaps[i])
-                for spring in springs:
-                    if spring.index in flips and spring.element == i:  # across the grazed breakpoint
+                for spring in flipped_springs:
+                    if spring.element == i:  # across the grazed breakpoint
                         interval = spring.breakpoint + 1 if interval == spring.breakpoint else spring.breakpoint
                 if law.fractional and law.fractional[interval] and moved_across(i):
                     fractional.append((piece, i, interval))
