@@ -606,7 +606,7 @@ class BranchHierarchy(LazyOrders):
             data["quotients"].append([q.value(unknowns) for q in top_quotient])
             data["length"].append(unknowns[1])
             release = system.release_at(order)
-            heights = [self._arc_height(k, unknowns, constant, unit).value(unknowns) if k != mode else
+            heights = [self._arc_height(k, unit).value(unknowns) if k != mode else
                        (zero if release is None else release) for k in range(size)]
             top.fix(order, heights, mu)
         elif top is not None:
@@ -658,7 +658,7 @@ class BranchHierarchy(LazyOrders):
         y = slope_target - value_of(1, 0, constant(domain.zero), constant(domain.zero), point, True)
         return [x.scale(cosine) - y.scale(sine)], [x.scale(sine) + y.scale(cosine)], quotient
 
-    def _arc_height(self, k: int, unknowns: Any, constant: Any, unit: Any) -> _Affine:
+    def _arc_height(self, k: int, unit: Any) -> _Affine:
         """The release value h_k (k ≠ j) of an N-dof first-piece arc among the order's unknowns."""
         position = k if k < self.system.mode else k - 1
         return unit(2 + position)
@@ -685,7 +685,7 @@ class BranchHierarchy(LazyOrders):
             end, end_slope = (domain.dtype(x) for x in ends[k])
             dh_value, dh_slope, dmu_value, dmu_slope = (domain.dtype(x) for x in arc.end_terms(k))
             height = constant(domain.zero if release is None else release) if k == mode else \
-                self._arc_height(k, None, constant, unit)
+                self._arc_height(k, unit)
             value = constant(end) + height.scale(dh_value) + mu.scale(dmu_value)
             slope = constant(end_slope) + height.scale(dh_slope) + mu.scale(dmu_slope)
             if boundary.coupling[k]:
