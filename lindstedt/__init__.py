@@ -63,6 +63,7 @@ _LAZY = {
     "problems.system": ("Modes", "UnilateralSystem"),
     "problems.structures": ("read_matrices", "sparse_modes"),
     "problems.beam": ("EulerBernoulliBeam",),
+    "problems.reduction": ("ResidualFlexibility", "ReducedStructure"),
     "validate": (
         "Spectrum",
         "contact_measure",
@@ -109,6 +110,8 @@ __all__ = [
     "read_matrices",
     "sparse_modes",
     "EulerBernoulliBeam",
+    "ResidualFlexibility",
+    "ReducedStructure",
     "StrainedCoordinatesNNM",
     "NNMProblem",
     "NNMExpansion",

@@ -1,0 +1,468 @@
+"""Modal truncation with residual flexibility: a large structure reduced to its low modes and one static vector
+per element, projected in multiprecision.
+
+The structure ``M X'' + K X + ε Σ_i w_i f_i(a_iᵀ X − b_i) = 0`` (N dof, sparse: a finite-element model) is
+written ``X = V q`` on the basis
+
+    ``V = [Φ_K, Z]``,   ``Φ_K`` the K lowest modes,   ``Z = K⁻¹ W − Φ_K (Φ_Kᵀ M K⁻¹ W)``,
+
+``Z`` the **residual flexibility** — the static response to the elements' forces that the kept modes miss
+(MacNeal 1971; Rubin 1975; Craig & Kurdila, *Fundamentals of Structural Dynamics*, 2006, §17.3): the modes above
+the cut respond to the element forces nearly statically, their periods being short against the NNM's.  The
+Galerkin (Rayleigh–Ritz) projection
+
+    ``(VᵀMV) q'' + (VᵀKV) q + ε Σ_i (Vᵀ w_i) f_i((a_iᵀ V) q − b_i) = 0``
+
+is a :class:`~lindstedt.problems.system.UnilateralSystem` of K + m dof with the same laws, which every engine
+takes (strained coordinates, shooting, forced responses).  The truncation is a model reduction, not an exact
+step: ``ω₀`` and ``ω₁`` of an NNM of a kept mode are those of the full model to the working precision (the mode
+is in the basis), ``ω₂`` and beyond carry the truncation error.  Measured against the full 201-dof cracked
+cantilever (all 201 modes, 30 digits): ω₂ errs by 1e-3 (relative) with K = 2 modes alone and still 2e-4 with 32
+(the forces' quasi-static share is missing); with the residual vector, by 1e-10 at K = 2…8, 1e-13 at 12 and
+1e-15 at 32 (``tests/test_reduction.py`` fits the order).
+
+**Precision.**  A float64 factorisation of a fine mesh loses ``eps · cond(K)`` (λ₁ of the float Lanczos
+modes is 1e-3 off at 10⁴ dof), so the basis is computed in multiprecision (gmpy2 ``mpfr`` at the working digits
+plus ``log10 cond(K)`` and guard digits): ``K = L D Lᵀ`` in its band after a reverse Cuthill–McKee ordering —
+O(N b²) for the factorisation, O(N b) per right-hand side, O(N · (K + m)) numbers kept — and subspace
+iteration ``Y ← K⁻¹ M X`` with a Rayleigh–Ritz step (Bathe & Wilson 1972) from the float Lanczos modes until
+the K Ritz values are stationary to the working precision.  The blocks of ``VᵀKV`` are formed without products
+with K (``K Y = M X``, ``K K⁻¹W = W``), so no digits cancel there.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import mpmath
+import numpy as np
+import sympy
+
+from .._budget import Estimate, checkpoint
+from .._errors import ProblemError
+from .modes import _leading_sign
+from .system import UnilateralSystem
+
+__all__ = ["ResidualFlexibility", "ReducedStructure"]
+
+#: CPU seconds of one multiprecision multiply-add on a row of the band (gmpy2 mpfr in numpy object arrays,
+#: ~200 bits; measured: 3.7 µs for a row operation on 20 columns)
+_SECONDS_PER_OPERATION = 2.0e-7
+_MAX_ITERATIONS = 60
+
+
+def _gmpy2() -> Any:
+    import gmpy2
+
+    return gmpy2
+
+
+def _rational(value: Any) -> Any:
+    """An exact number (sympy, int, float, Fraction) as a gmpy2 mpq, or an mpfr at the current precision."""
+    gmpy2 = _gmpy2()
+    if isinstance(value, (int, np.integer)):
+        return gmpy2.mpq(int(value))
+    if isinstance(value, (float, np.floating)):
+        return gmpy2.mpq(float(value))
+    value = sympy.sympify(value)  # already an exact sympy number here (from the problem's own matrices)
+    if value.is_Rational:
+        return gmpy2.mpq(int(value.p), int(value.q))
+    return gmpy2.mpfr(str(sympy.N(value, int(gmpy2.get_context().precision * 0.302) + 5)))
+
+
+def _entries(matrix: Any, rows: int, cols: int, name: str) -> dict[tuple[int, int], Any]:
+    """The nonzero entries ``(i, j) -> exact value`` of a scipy.sparse, numpy or sympy matrix of shape (rows, cols)."""
+    import scipy.sparse
+
+    if isinstance(matrix, dict):
+        pairs = matrix.items()
+    elif isinstance(matrix, sympy.MatrixBase):
+        if matrix.shape != (rows, cols):
+            raise ProblemError(f"{name} is {matrix.shape[0]}×{matrix.shape[1]}, expected {rows}×{cols}")
+        pairs = matrix.todok().items()
+    else:
+        if scipy.sparse.issparse(matrix):
+            coo = scipy.sparse.coo_matrix(matrix)
+        else:
+            array = np.asarray(matrix)
+            if array.dtype == object or not np.issubdtype(array.dtype, np.number) or np.iscomplexobj(array):
+                raise ProblemError(f"{name} must be a real numeric matrix (numpy, scipy.sparse or sympy), got {matrix!r:.80}")
+            coo = scipy.sparse.coo_matrix(np.atleast_2d(array).astype(float))
+        if coo.shape != (rows, cols):
+            raise ProblemError(f"{name} is {coo.shape[0]}×{coo.shape[1]}, expected {rows}×{cols}")
+        if not np.all(np.isfinite(coo.data)):
+            raise ProblemError(f"{name} has a non-finite entry; give finite numbers")
+        pairs = {}
+        for i, j, v in zip(coo.row.tolist(), coo.col.tolist(), coo.data.tolist()):
+            pairs[i, j] = pairs.get((i, j), 0.0) + v
+        pairs = pairs.items()
+    return {key: _rational(value) for key, value in pairs if value != 0}
+
+
+class _BandedLDL:
+    """``P S Pᵀ = L D Lᵀ`` of a symmetric positive definite sparse matrix S in its band, P the reverse
+    Cuthill–McKee ordering, in gmpy2 mpfr at the context's precision; solves on object arrays of columns."""
+
+    def __init__(self, entries: dict[tuple[int, int], Any], n: int) -> None:
+        import scipy.sparse
+        from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+        gmpy2 = _gmpy2()
+        keys = list(entries)
+        pattern = scipy.sparse.csr_matrix((np.ones(len(keys)), ([k[0] for k in keys], [k[1] for k in keys])), shape=(n, n))
+        order = np.asarray(reverse_cuthill_mckee(pattern, symmetric_mode=True), dtype=np.int64)
+        position = np.empty(n, dtype=np.int64)
+        position[order] = np.arange(n)
+        self.order, self.position, self.n = order, position, n
+        rows: list[dict[int, Any]] = [{} for _ in range(n)]
+        width = 0
+        for (i, j), value in entries.items():
+            p, q = int(position[i]), int(position[j])
+            if q <= p:
+                rows[p][q] = gmpy2.mpfr(value)
+                width = max(width, p - q)
+        self.width = width
+        lower: list[list[tuple[int, Any]]] = []
+        diagonal: list[Any] = []
+        zero = gmpy2.mpfr(0)
+        for i in range(n):
+            start = max(0, i - width)
+            row = [rows[i].get(j, zero) for j in range(start, i + 1)]
+            # row[j - start] becomes L[i, j] D[j] while the later entries are reduced (Crout, band of width b)
+            for j in range(start, i):
+                total = row[j - start]
+                for k, lik_dk in lower[j]:  # L[j, k] for k < j, stored as (k, L[j, k])
+                    if k >= start:
+                        total -= row[k - start] * lik_dk
+                row[j - start] = total
+            entries_i = []
+            total = row[i - start]
+            for j in range(start, i):
+                l_ij = row[j - start] / diagonal[j]
+                total -= l_ij * row[j - start]
+                if l_ij:
+                    entries_i.append((j, l_ij))
+            if not total > 0:
+                raise ProblemError("K is not positive definite (a non-positive pivot in its L D Lᵀ factorisation): the "
+                                   "structure is a mechanism; fix its supports")
+            diagonal.append(total)
+            lower.append(entries_i)
+        self.lower, self.diagonal = lower, diagonal
+
+    def solve(self, columns: np.ndarray) -> np.ndarray:
+        """``S⁻¹ columns`` for an (n, c) object array of mpfr."""
+        y = columns[self.order].copy()
+        for i, entries in enumerate(self.lower):
+            for j, l_ij in entries:
+                y[i] = y[i] - y[j] * l_ij
+        for i in range(self.n):
+            y[i] = y[i] / self.diagonal[i]
+        for j in range(self.n - 1, -1, -1):
+            for i, l_ji in self.lower[j]:  # Lᵀ: row i < j of Lᵀ takes L[j, i]
+                y[i] = y[i] - y[j] * l_ji
+        result = np.empty_like(y)
+        result[self.order] = y
+        return result
+
+
+class _SparseProduct:
+    """``S @ columns`` for exact sparse entries, in mpfr, grouped by diagonal (vectorised over rows)."""
+
+    def __init__(self, entries: dict[tuple[int, int], Any], n: int) -> None:
+        gmpy2 = _gmpy2()
+        by_offset: dict[int, tuple[list[int], list[Any]]] = {}
+        for (i, j), value in entries.items():
+            rows, values = by_offset.setdefault(j - i, ([], []))
+            rows.append(i)
+            values.append(gmpy2.mpfr(value))
+        self.diagonals = [(offset, np.array(rows, dtype=np.int64), np.array(values, dtype=object)[:, None])
+                          for offset, (rows, values) in by_offset.items()]
+        self.n = n
+
+    def times(self, columns: np.ndarray) -> np.ndarray:
+        result = np.zeros(columns.shape, dtype=object) + _gmpy2().mpfr(0)
+        for offset, rows, values in self.diagonals:
+            result[rows] = result[rows] + values * columns[rows + offset]  # one entry per row on a diagonal
+        return result
+
+
+def _to_mpmath(value: Any) -> Any:
+    mantissa, exponent = value.as_mantissa_exp()
+    return mpmath.ldexp(mpmath.mpf(int(mantissa)), int(exponent))
+
+
+def _to_mpfr(value: Any) -> Any:
+    gmpy2 = _gmpy2()
+    value = mpmath.mpf(value)
+    mantissa, exponent = value.man_exp  # the mantissa's magnitude
+    return gmpy2.mul_2exp(gmpy2.mpfr(-int(mantissa) if value < 0 else int(mantissa)), int(exponent))
+
+
+def _exact(value: Any) -> sympy.Rational:
+    numerator, denominator = value.as_integer_ratio()
+    return sympy.Rational(int(numerator), int(denominator))
+
+
+@dataclass(frozen=True)
+class ReducedStructure:
+    """A structure reduced by :class:`ResidualFlexibility`: the reduced ``system`` and how it was obtained.
+
+    Attributes
+    ----------
+    system : UnilateralSystem
+        The projected model, ``modes + m`` dof (the kept modes, then one residual vector per element), with the
+        elements' laws; its data are the projections to the working precision, as exact binary rationals.
+    n_dof : int
+        Degrees of freedom of the full model.
+    modes : int
+        Modes kept.
+    frequencies : tuple
+        The kept λ_k of the full model (mpmath mpf, ``digits`` digits: the converged Ritz values).
+    digits : int
+        The working precision of the projection.
+    success : bool
+        Whether the Ritz values converged to ``digits`` digits within the iterations allowed.
+    message : str
+        What happened.
+    iterations, solves : int
+        Subspace iterations and multiprecision solves with ``K`` (block solves, one column each).
+    bandwidth : int
+        The half-bandwidth of ``K`` in the reverse Cuthill–McKee ordering (the factorisation costs O(N b²)).
+    """
+
+    system: UnilateralSystem
+    n_dof: int
+    modes: int
+    frequencies: tuple[Any, ...]
+    digits: int
+    success: bool
+    message: str
+    iterations: int
+    solves: int
+    bandwidth: int
+
+
+@dataclass(frozen=True)
+class ResidualFlexibility:
+    """Reduce a large structure to ``modes`` low modes plus one residual-flexibility vector per element.
+
+    Parameters
+    ----------
+    modes : int
+        The number K of lowest modes kept (``1 ≤ K``, ``K + m < N``).
+    digits : int
+        The working precision of the reduced model's data (default 30).
+
+    Examples
+    --------
+    >>> import lindstedt
+    >>> beam = lindstedt.EulerBernoulliBeam(40, cracks=[(10, 10)])
+    >>> reduced = ResidualFlexibility(modes=6).reduce(beam)
+    >>> reduced.system.n_dof, reduced.success
+    (7, True)
+    >>> full = lindstedt.nnm(beam.system(), 1, a0=1, order=1).omega
+    >>> small = lindstedt.nnm(reduced.system, 1, a0=1, order=1).omega
+    >>> [float(abs(x - y)) < 1e-25 for x, y in zip(full, small)]     # ω₀, ω₁: a kept mode's are exact
+    [True, True]
+    """
+
+    modes: int = 12
+    digits: int = 30
+
+    def __post_init__(self) -> None:
+        for name in ("modes", "digits"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+                raise ProblemError(f"{name} must be a positive integer, got {value!r}")
+
+    def reduce(self, structure: Any, A: Any = None, b: Any = None, W: Any = None, laws: Any = None) -> ReducedStructure:
+        """The reduced model of ``structure``.
+
+        Parameters
+        ----------
+        structure : EulerBernoulliBeam or (M, K)
+            A beam (its exact matrices and its cracks as the elements), or the mass and stiffness matrices
+            (scipy.sparse, numpy or sympy; floats are taken as the binary numbers they are), symmetric, K
+            positive definite.
+        A, b, W, laws
+            The elements as for :class:`~lindstedt.problems.system.UnilateralSystem` (``A`` m×N required with
+            matrices; ``b`` default zeros, ``W`` default ``Aᵀ``, ``laws`` default the unilateral spring); not
+            given with a beam.
+
+        Returns
+        -------
+        ReducedStructure
+
+        Raises
+        ------
+        ProblemError
+            On inconsistent shapes, a K that is not positive definite, too many modes.
+        BudgetError
+            When the estimated cost exceeds the budget in force.
+        """
+        from .beam import EulerBernoulliBeam
+
+        if isinstance(structure, EulerBernoulliBeam):
+            if any(value is not None for value in (A, b, W, laws)):
+                raise ProblemError("a beam brings its own elements (its cracks): do not pass A, b, W or laws with it")
+            n = structure.n_dof
+            mass, stiffness = ({key: _rational(v) for key, v in part.items()} for part in structure._exact)
+            elements = {key: _rational(v) for key, v in structure._A_exact.items()}
+            m = len(structure.cracks)
+            gaps = [crack[3] for crack in structure.cracks]
+            forces = None
+            laws = None
+        else:
+            if isinstance(structure, (str, bytes)) or not isinstance(structure, (tuple, list)) or len(structure) != 2:
+                raise ProblemError("structure must be an EulerBernoulliBeam or a pair (M, K) of matrices")
+            if A is None:
+                raise ProblemError("give the elements' rows A (m×N) with the matrices (M, K)")
+            shape = getattr(structure[1], "shape", None)
+            if shape is None or len(shape) != 2 or shape[0] != shape[1]:
+                raise ProblemError(f"K must be a square matrix, got shape {shape}")
+            n = int(shape[0])
+            mass = _entries(structure[0], n, n, "M")
+            stiffness = _entries(structure[1], n, n, "K")
+            rows_A = getattr(A, "shape", None) or np.shape(np.asarray(A, dtype=object))
+            m = int(rows_A[0]) if len(rows_A) == 2 else 1
+            elements = _entries(A, m, n, "A")
+            gaps = [0] * m if b is None else list(b)
+            if len(gaps) != m:
+                raise ProblemError(f"b has {len(gaps)} entries for {m} elements")
+            forces = None if W is None else _entries(W, n, m, "W")
+        if self.modes + m >= n:
+            raise ProblemError(f"{self.modes} modes and {m} elements leave nothing to reduce in {n} dof; keep fewer "
+                               "modes (modes + elements < N) or use the full system")
+        return _reduce(self, n, m, mass, stiffness, elements, forces, gaps, laws)
+
+    def estimate(self, n: int, bandwidth: int, elements: int, iterations: int) -> Estimate:
+        """The cost of a reduction of an N-dof model whose K has half-bandwidth ``bandwidth``."""
+        columns = self.modes + max(4, self.modes // 2)
+        # the factorisation, then per iteration the band solves and products (N (4b + 5) q) and the Gram matrices and
+        # the Ritz transforms (5 N q²), then the residual vectors
+        operations = (n * bandwidth**2 + iterations * n * ((4 * bandwidth + 5) * columns + 5 * columns**2)
+                      + n * (2 * bandwidth + 1) * elements)
+        return Estimate(task=f"residual-flexibility reduction of a {n}-dof model to {self.modes} modes",
+                        seconds=_SECONDS_PER_OPERATION * operations,
+                        memory_mb=3e-4 * n * (bandwidth + 6 * columns + elements),  # ~150 bytes per mpfr kept
+                        drivers=(("degrees of freedom", n), ("half-bandwidth", bandwidth), ("modes", self.modes)),
+                        advice="keep fewer modes")
+
+
+def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: dict, elements: dict, forces: dict | None,
+            gaps: list, laws: Any) -> ReducedStructure:
+    import scipy.sparse
+
+    from .structures import sparse_modes
+
+    gmpy2 = _gmpy2()
+    K = method.modes
+    columns = min(n - 1, K + max(4, K // 2))
+
+    def as_float(entries: dict) -> Any:
+        keys = list(entries)
+        return scipy.sparse.csc_matrix(([float(entries[k]) for k in keys], ([k[0] for k in keys], [k[1] for k in keys])),
+                                       shape=(n, n))
+
+    float_modes = sparse_modes(as_float(mass), as_float(stiffness), columns)
+    theta = float_modes.frequencies**2
+    stiffest = max(float(abs(v)) for (i, j), v in stiffness.items() if i == j)
+    lightest = min(float(v) for (i, j), v in mass.items() if i == j)
+    conditioning = max(1.0, stiffest / lightest / float(theta[0]))
+    # the Ritz values are stationary to 2^-2t when the vectors are to 2^-t (t the target bits): room for both
+    target = int(math.ceil(method.digits * math.log2(10))) + 8
+    bits = 2 * target + int(math.ceil(math.log2(conditioning))) + 32
+    rate = float(theta[K - 1] / theta[-1]) if columns > K else 0.5
+    # a Ritz value's error falls by rate² = (θ_K/θ_q)² per iteration, from the float modes' (~2^-20 at worst)
+    iterations = min(_MAX_ITERATIONS, int(math.ceil(2 * target / max(1.0, -2 * math.log2(max(rate, 1e-300))))) + 2)
+    with gmpy2.context(gmpy2.get_context(), precision=bits):
+        factor = _BandedLDL(stiffness, n)
+        method.estimate(n, factor.width, m, iterations).check()
+        product = _SparseProduct(mass, n)
+        to_mpfr = np.vectorize(lambda v: gmpy2.mpfr(float(v)), otypes=[object])
+        X = to_mpfr(float_modes.shapes)
+        MX = product.times(X)
+        previous: list[Any] | None = None
+        success, done, solves = False, 0, 0
+        tolerance = mpmath.mpf(2) ** (-2 * target)
+        with mpmath.workprec(bits):
+            for done in range(1, _MAX_ITERATIONS + 1):
+                Y = factor.solve(MX)  # K Y = M X
+                solves += columns
+                MY = product.times(Y)
+                stiff = _small(Y.T.dot(MX))
+                massive = _small(Y.T.dot(MY))
+                values, Q = _ritz(stiff, massive)
+                transform = np.array([[_to_mpfr(Q[i, j]) for j in range(columns)] for i in range(columns)], dtype=object)
+                KX = MX.dot(transform)  # K (Y Q) = M X Q
+                X, MX = Y.dot(transform), MY.dot(transform)
+                kept = values[:K]
+                if previous is not None and all(abs(a - b) <= tolerance * abs(a) for a, b in zip(kept, previous)):
+                    success = True
+                    break
+                previous = kept
+                checkpoint("subspace iteration", done, _MAX_ITERATIONS)
+            X, KX, MX = X[:, :K], KX[:, :K], MX[:, :K]
+            # each mode signed as the full model's modes are (its first entry of largest magnitude positive)
+            signs = np.array([_leading_sign([float(v) for v in X[:, k]]) for k in range(K)], dtype=object)
+            X, KX, MX = X * signs, KX * signs, MX * signs
+            W = np.zeros((n, m), dtype=object) + gmpy2.mpfr(0)
+            if forces is None:
+                for (i, j), value in elements.items():
+                    W[j, i] = gmpy2.mpfr(value)
+            else:
+                for (i, j), value in forces.items():
+                    W[i, j] = gmpy2.mpfr(value)
+            Z = factor.solve(W)  # K Z = W
+            solves += m
+            coefficients = MX.T.dot(Z)  # Φᵀ M Z, Φ M-orthonormal
+            Z = Z - X.dot(coefficients)
+            KZ = W - KX.dot(coefficients)
+            MZ = product.times(Z)
+            V, KV, MV = (np.hstack(pair) for pair in ((X, Z), (KX, KZ), (MX, MZ)))
+            reduced_mass = V.T.dot(MV)
+            reduced_stiffness = V.T.dot(KV)
+            A = np.zeros((m, n), dtype=object) + gmpy2.mpfr(0)
+            for (i, j), value in elements.items():
+                A[i, j] = gmpy2.mpfr(value)
+            reduced_A = A.dot(V)
+            reduced_W = V.T.dot(W)
+            frequencies = tuple(+mpmath.sqrt(value) for value in values[:K])
+
+        def exact(matrix: np.ndarray, symmetric: bool) -> sympy.Matrix:
+            if symmetric:
+                matrix = (matrix + matrix.T) / 2
+            return sympy.Matrix(matrix.shape[0], matrix.shape[1], [_exact(v) for v in matrix.ravel()])
+
+        system = UnilateralSystem(exact(reduced_mass, True), exact(reduced_stiffness, True), exact(reduced_A, False),
+                                  gaps, exact(reduced_W, False), laws)
+    with mpmath.workdps(method.digits):
+        frequencies = tuple(+value for value in frequencies)
+    message = (f"{K} modes converged to {method.digits} digits in {done} subspace iterations" if success else
+               f"the Ritz values were still moving after {done} subspace iterations: the kept modes are not converged "
+               f"to {method.digits} digits (keep fewer modes, or more: the convergence rate is (λ_K/λ_q)²)")
+    return ReducedStructure(system, n, K, frequencies, method.digits, success, message, done, solves, factor.width)
+
+
+def _small(matrix: np.ndarray) -> Any:
+    """A small symmetric object matrix of mpfr as an mpmath matrix (symmetrised)."""
+    size = matrix.shape[0]
+    return mpmath.matrix([[(_to_mpmath(matrix[i, j]) + _to_mpmath(matrix[j, i])) / 2 for j in range(size)] for i in range(size)])
+
+
+def _ritz(stiffness: Any, mass: Any) -> tuple[list[Any], Any]:
+    """The generalized eigenpairs of the small pencil (stiffness, mass): values increasing, vectors mass-orthonormal."""
+    lower = mpmath.cholesky(mass)
+    inverse = mpmath.inverse(lower)
+    symmetric = inverse * stiffness * inverse.T
+    values, vectors = mpmath.eigsy((symmetric + symmetric.T) / 2)
+    order = sorted(range(len(values)), key=lambda i: values[i])
+    vectors = inverse.T * vectors
+    size = len(values)
+    ordered = mpmath.matrix(size, size)
+    for new, old in enumerate(order):
+        for row in range(size):
+            ordered[row, new] = vectors[row, old]
+    return [values[i] for i in order], ordered

@@ -1,0 +1,121 @@
+"""Modal truncation with residual flexibility (lindstedt.ResidualFlexibility): a large structure reduced to its low
+modes plus one static vector per element.
+
+References, none from the code under test: the full model's strained-coordinates NNM (every mode to 30 digits,
+itself checked against shooting and closed forms in test_structures / test_nnm_element_laws); the plain modal
+truncation (the same kept modes without the residual vector) as the baseline the residual flexibility must beat.
+"""
+
+from __future__ import annotations
+
+import mpmath
+import numpy as np
+import pytest
+
+import lindstedt
+from lindstedt import EulerBernoulliBeam, ResidualFlexibility, UnilateralSystem
+
+
+def _relative(values, reference):
+    return [abs(a - b) / abs(b) for a, b in zip(values, reference)]
+
+
+@pytest.fixture(scope="module")
+def cracked_beam():
+    beam = EulerBernoulliBeam(40, cracks=[(10, 10)])
+    return beam, lindstedt.nnm(beam.system(), 1, a0=1, order=2).omega
+
+
+def _truncated(system: UnilateralSystem, elements: int) -> UnilateralSystem:
+    """The same Galerkin projection without the residual vectors (plain modal truncation)."""
+    keep = system.n_dof - elements
+    return UnilateralSystem(system.M_exact[:keep, :keep], system.K_exact[:keep, :keep], system.A_exact[:, :keep],
+                            list(system.b), system.W_exact[:keep, :])
+
+
+def test_kept_mode_is_exact_and_residual_flexibility_beats_truncation(cracked_beam):
+    beam, full = cracked_beam
+    for modes in (2, 4):
+        reduced = ResidualFlexibility(modes=modes).reduce(beam)
+        assert reduced.success, reduced.message
+        assert reduced.system.n_dof == modes + 1 and reduced.n_dof == beam.n_dof == 81
+        assert reduced.bandwidth <= 4
+        omega = lindstedt.nnm(reduced.system, 1, a0=1, order=2).omega
+        # ω₀ and ω₁ of a kept mode are the full model's to the working precision (30 digits)
+        assert all(error < 1e-28 for error in _relative(omega[:2], full[:2]))
+        # the mode is the full model's first: λ₁ equals its refined value
+        assert abs(reduced.frequencies[0] - full[0]) < 1e-28
+        # ω₂ carries the truncation: with the residual vector at least 10³ times smaller than without it
+        plain = lindstedt.nnm(_truncated(reduced.system, 1), 1, a0=1, order=2).omega
+        with_residual = _relative(omega[2:], full[2:])[0]
+        without = _relative(plain[2:], full[2:])[0]
+        assert with_residual < 1e-3 * without, (modes, with_residual, without)
+        assert with_residual < 1e-3
+
+
+@pytest.mark.slow
+def test_truncation_error_falls_with_the_modes_kept():
+    beam = EulerBernoulliBeam(100, cracks=[(25, 10)])
+    full = lindstedt.nnm(beam.system(), 1, a0=1, order=2).omega
+    errors = []
+    for modes in (4, 8, 12, 16):
+        reduced = ResidualFlexibility(modes=modes).reduce(beam)
+        omega = lindstedt.nnm(reduced.system, 1, a0=1, order=2).omega
+        assert all(error < 1e-28 for error in _relative(omega[:2], full[:2]))
+        errors.append(float(_relative(omega[2:], full[2:])[0]))
+    # not monotone mode by mode (a mode whose curvature vanishes at the crack adds nothing), but falling overall
+    assert errors[-1] < 1e-2 * errors[0], errors
+    assert errors[-1] < 1e-9, errors
+
+
+def test_matrices_and_any_law_match_the_full_system():
+    full_system = UnilateralSystem.chain(12, unilateral=[(3, 0)])
+    cubic = "u**3"
+    laws_system = UnilateralSystem(full_system.M_exact, full_system.K_exact, full_system.A_exact, [0],
+                                   full_system.W_exact, [cubic])
+    M = np.array(full_system.M_exact.tolist(), dtype=float)
+    K = np.array(full_system.K_exact.tolist(), dtype=float)
+    A = np.array(full_system.A_exact.tolist(), dtype=float)
+    for system, laws in ((full_system, None), (laws_system, [cubic])):
+        reference = lindstedt.nnm(system, 1, a0=1, order=2).omega
+        import scipy.sparse
+
+        reduced = ResidualFlexibility(modes=3).reduce((scipy.sparse.csr_matrix(M), K), A=A, laws=laws)
+        assert reduced.system.n_dof == 4
+        omega = lindstedt.nnm(reduced.system, 1, a0=1, order=2).omega
+        assert all(error < 1e-28 for error in _relative(omega[:2], reference[:2]))
+        assert _relative(omega[2:], reference[2:])[0] < 1e-2
+
+
+def test_estimate_and_budget(cracked_beam):
+    beam, _ = cracked_beam
+    estimate = ResidualFlexibility(modes=6).estimate(10001, 4, 1, 40)
+    assert estimate.seconds > 1 and estimate.memory_mb > 10
+    with lindstedt.limits.budget(seconds=1e-6):
+        with pytest.raises(lindstedt.limits.BudgetError, match="residual-flexibility reduction"):
+            ResidualFlexibility(modes=2).reduce(beam)
+
+
+@pytest.mark.parametrize("build, match", [
+    (lambda beam: ResidualFlexibility(modes=0), "modes must be a positive integer"),
+    (lambda beam: ResidualFlexibility(modes=2, digits=True), "digits must be a positive integer"),
+    (lambda beam: ResidualFlexibility(modes=80).reduce(beam), "leave nothing to reduce"),
+    (lambda beam: ResidualFlexibility(modes=2).reduce(beam, A=np.ones((1, 81))), "brings its own elements"),
+    (lambda beam: ResidualFlexibility(modes=2).reduce("beam.npz"), "EulerBernoulliBeam or a pair"),
+    (lambda beam: ResidualFlexibility(modes=2).reduce((beam.M, beam.K)), "give the elements' rows A"),
+    (lambda beam: ResidualFlexibility(modes=2).reduce((beam.M, beam.K), A=np.ones((1, 5))), "expected 1×81"),
+    (lambda beam: ResidualFlexibility(modes=2).reduce((beam.M, -beam.K), A=np.ones((1, 81))), "positive definite"),
+])
+def test_bad_input(cracked_beam, build, match):
+    beam, _ = cracked_beam
+    with pytest.raises(lindstedt.ProblemError, match=match):
+        build(beam)
+
+
+def test_precision_does_not_leak(cracked_beam):
+    import gmpy2
+
+    beam, _ = cracked_beam
+    before = (mpmath.mp.prec, gmpy2.get_context().precision)
+    ResidualFlexibility(modes=2, digits=20).reduce(beam)
+    assert (mpmath.mp.prec, gmpy2.get_context().precision) == before
