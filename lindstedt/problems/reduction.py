@@ -33,7 +33,7 @@ Products with K cancel up to log2 cond(K) bits, which the working precision hold
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import mpmath
@@ -242,7 +242,8 @@ class ReducedStructure:
     Attributes
     ----------
     system : UnilateralSystem
-        The projected model, ``modes + m`` dof (the kept modes, then one residual vector per element), with the
+        The projected model: the kept modes, then the residual vectors of the elements (and loads) that the modes
+        and one another leave independent (``modes + m`` dof when they all are), with the
         elements' laws; its data are the projections to the working precision, as exact binary rationals.
     n_dof : int
         Degrees of freedom of the full model.
@@ -260,6 +261,10 @@ class ReducedStructure:
         Subspace iterations and multiprecision solves with ``K`` (block solves, one column each).
     bandwidth : int
         The half-bandwidth of ``K`` in the reverse Cuthill–McKee ordering (the factorisation costs O(N b²)).
+    loads : tuple
+        The projections ``Vᵀ P`` of the ``loads`` given (one tuple of exact numbers per load).
+    basis : numpy.ndarray
+        ``V`` in float64 (N × reduced dof): the full displacements ``X ≈ V q`` of a reduced state ``q``.
     """
 
     system: UnilateralSystem
@@ -272,6 +277,8 @@ class ReducedStructure:
     iterations: int
     solves: int
     bandwidth: int
+    loads: tuple[tuple[Any, ...], ...]
+    basis: np.ndarray = field(repr=False)
 
 
 @dataclass(frozen=True)
@@ -307,7 +314,8 @@ class ResidualFlexibility:
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
                 raise ProblemError(f"{name} must be a positive integer, got {value!r}")
 
-    def reduce(self, structure: Any, A: Any = None, b: Any = None, W: Any = None, laws: Any = None) -> ReducedStructure:
+    def reduce(self, structure: Any, A: Any = None, b: Any = None, W: Any = None, laws: Any = None,
+               loads: Any = None) -> ReducedStructure:
         """The reduced model of ``structure``.
 
         Parameters
@@ -320,6 +328,11 @@ class ResidualFlexibility:
             The elements as for :class:`~lindstedt.problems.system.UnilateralSystem` (``A`` m×N required with
             matrices; ``b`` default zeros, ``W`` default ``Aᵀ``, ``laws`` default the unilateral spring); not
             given with a beam.
+        loads : array_like, optional
+            Load shapes ``P`` (N, or N × p) of a forced problem ``… = ε P cos Ωt``: their static residuals join the
+            basis (a load away from the elements excites the modes above the cut quasi-statically too), and
+            :attr:`ReducedStructure.loads` holds their projections ``Vᵀ P`` for
+            :class:`~lindstedt.ForcedSystem`.
 
         Returns
         -------
@@ -365,7 +378,15 @@ class ResidualFlexibility:
         if self.modes + m >= n:
             raise ProblemError(f"{self.modes} modes and {m} elements leave nothing to reduce in {n} dof; keep fewer "
                                "modes (modes + elements < N) or use the full system")
-        return _reduce(self, n, m, mass, stiffness, elements, forces, gaps, laws)
+        load_entries = []
+        if loads is not None:
+            array = np.asarray(loads, dtype=object)
+            columns = array.reshape(n, -1) if array.size and array.shape[0] == n else None
+            if columns is None:
+                raise ProblemError(f"loads must have one row per degree of freedom ({n}), got shape {array.shape}")
+            load_entries = [{i: _rational(value) for i, value in enumerate(columns[:, c]) if value != 0}
+                            for c in range(columns.shape[1])]
+        return _reduce(self, n, m, mass, stiffness, elements, forces, gaps, laws, load_entries)
 
     def estimate(self, n: int, bandwidth: int, elements: int, iterations: int, steps: int = 1) -> Estimate:
         """The cost of a reduction of an N-dof model whose K has half-bandwidth ``bandwidth``."""
@@ -382,7 +403,7 @@ class ResidualFlexibility:
 
 
 def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: dict, elements: dict, forces: dict | None,
-            gaps: list, laws: Any) -> ReducedStructure:
+            gaps: list, laws: Any, loads: list) -> ReducedStructure:
     import scipy.sparse
 
     from .structures import sparse_modes
@@ -454,11 +475,23 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
             else:
                 for (i, j), value in forces.items():
                     W[i, j] = gmpy2.mpfr(value)
-            Z = factor.solve(W)  # K Z = W
-            solves += m
+            P = np.zeros((n, len(loads)), dtype=object) + gmpy2.mpfr(0)
+            for column, load in enumerate(loads):
+                for i, value in load.items():
+                    P[i, column] = gmpy2.mpfr(value)
+            statics = np.hstack((W, P))
+            Z = factor.solve(statics)  # K Z = [W, P]
+            solves += statics.shape[1]
             coefficients = MX.T.dot(Z)  # Φᵀ M Z, Φ M-orthonormal
             Z = Z - X.dot(coefficients)
-            KZ = W - KX.dot(coefficients)
+            KZ = statics - KX.dot(coefficients)
+            # M-orthonormal residual vectors, those the kept modes and the others already span dropped (two stops on
+            # one dof, a load on a contact dof): the eigenvectors of their Gram matrix above 2^-t of the largest
+            gram, U = mpmath.eigsy(_small(Z.T.dot(product.times(Z))))
+            largest = max(gram[i] for i in range(gram.rows))
+            keep = [i for i in range(gram.rows) if gram[i] > largest * mpmath.mpf(2) ** (-target)]
+            scale = np.array([[_to_mpfr(U[r, i] / mpmath.sqrt(gram[i])) for i in keep] for r in range(gram.rows)], dtype=object)
+            Z, KZ = Z.dot(scale), KZ.dot(scale)
             MZ = product.times(Z)
             V, KV, MV = (np.hstack(pair) for pair in ((X, Z), (KX, KZ), (MX, MZ)))
             reduced_mass = V.T.dot(MV)
@@ -468,6 +501,8 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
                 A[i, j] = gmpy2.mpfr(value)
             reduced_A = A.dot(V)
             reduced_W = V.T.dot(W)
+            reduced_loads = V.T.dot(P)
+            basis = V.astype(float)
             frequencies = tuple(+mpmath.sqrt(value) for value in values[:K])
 
         def exact(matrix: np.ndarray, symmetric: bool) -> sympy.Matrix:
@@ -477,12 +512,14 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
 
         system = UnilateralSystem(exact(reduced_mass, True), exact(reduced_stiffness, True), exact(reduced_A, False),
                                   gaps, exact(reduced_W, False), laws)
+        projected = tuple(tuple(_exact(v) for v in reduced_loads[:, column]) for column in range(len(loads)))
     with mpmath.workdps(method.digits):
         frequencies = tuple(+value for value in frequencies)
     message = (f"{K} modes converged to {method.digits} digits in {done} subspace iterations" if success else
                f"the Ritz values were still moving after {done} subspace iterations: the kept modes are not converged "
                f"to {method.digits} digits (keep fewer modes, or more: the convergence rate is (λ_K/λ_q)²)")
-    return ReducedStructure(system, n, K, frequencies, method.digits, success, message, done, solves, factor.width)
+    return ReducedStructure(system, n, K, frequencies, method.digits, success, message, done, solves, factor.width,
+                            projected, basis)
 
 
 def _small(matrix: np.ndarray) -> Any:
