@@ -36,16 +36,15 @@ first harmonic of the exact ``W_j`` including the moving-boundary terms
 ("harmonic").  ``W_j'(π) = 0`` is the secular (Fredholm) condition that fixes
 ``A_n``; for k ≠ j it fixes the periodic solution, which exists iff r_k ∉ ℤ.
 
-A fractional power law c |W − κ|^p (Hertz contact, p = 3/2) on a piece that holds a
-turning point makes that piece's solution non-analytic at its moving end; the piece is
-then a :class:`~lindstedt.engine.stretched.StretchedArc`, solved on a fixed interval
-(``BranchSystem.arcs``).  The first piece [0, s_1*): τ = s/s_1*, released at W_n(0) = w_n;
-its μ_n = [Ω²/s_1*²]_n and end slope are known, the order's unknowns become ``A_n`` and
-``σ_{1,n}`` (instead of the first piece's c), fixed with ``A_n = [μ s_1*²]_n`` after the next
-piece is matched to the arc's end (value κ, slope Y'(1)/s_1*).  The last piece (s_L*, π]:
-τ = (π − s)/(π − s_L*), W = −Y; the turning value h_n = Y_n(0) at π is one more unknown, and
-the conditions are the slope match at s_L* and ``A_n = [μ (π − s_L*)²]_n`` (instead of
-``W'(π) = 0``).
+A fractional power law (Hertz contact, p = 3/2) or an analytic law on a piece that holds a turning
+point makes that piece's solution non-analytic at its moving end; the piece is then a
+:class:`~lindstedt.engine.stretched.VectorArc` (the one arc implementation, any N), solved on a fixed
+interval (``BranchSystem.arcs``).  The first piece [0, s_1*): τ = s/s_1*, released at Y_j(0) = 1 + Σ w_n ε̂^n;
+the order's unknowns become ``A_n``, ``σ_{1,n}`` (the arc's length ℓ_n), the release values h_k (k ≠ j) and μ_n
+(instead of the first piece's c), fixed by the contact condition χ·Y_n(1) = 0, ``A_n = [μ s_1*²]_n`` and the
+next piece matched to the arc's end (value Y_k(1), slope Y_k'(1)/s_1*).  The last piece (s_L*, π]:
+τ = (π − s)/(π − s_L*), W = −Y; its turning values h_k = Y_{n,k}(0) at π and its μ_n are unknowns, and the
+conditions are the value and slope match at s_L* and ``A_n = [μ (π − s_L*)²]_n`` (instead of ``W'(π) = 0``).
 
 Coefficients live in any sympy field: exact (``QQ``, ``QQ(π, κ, β, …)``) or a
 ``RealField`` of the working precision (always, with a stretched arc).
@@ -134,7 +133,7 @@ class BranchSystem:
     pi_point: EvaluationPoint
     release: tuple[Any, ...]
     gauge: int = 1
-    arcs: tuple[Any, Any] = (None, None)  # StretchedArcs solving the first / last piece (N = 1), or None
+    arcs: tuple[VectorArc | None, VectorArc | None] = (None, None)  # the arcs solving the first / last piece
 
     def release_at(self, order: int) -> Any | None:
         """The prescribed W_{order,j}(0) in the gauge's powers (None: zero)."""
@@ -194,7 +193,7 @@ class BranchHierarchy(LazyOrders):
         self._derivatives: dict[tuple[int, int, int, int], Branch] = {}
         self._law_powers: dict[tuple, Branch] = {}
         # per stretched arc (first, last piece): its length ℓ_n (ℓ = s_1* or π − s_L*), μ_n = [Ω²/ℓ²]_n and
-        # Q_n = [Y'(1)/ℓ]_n, the slope it hands to its neighbour (Q_0 = −sin β)
+        # per component Q_{n,k} = [Y_k'(1)/ℓ]_n, the slope it hands to its neighbour (Q_{0,j} = −sin β)
         self._arc_data: list[dict[str, list[Any]] | None] = []
         for which, arc in enumerate(system.arcs):
             if arc is None:
@@ -202,7 +201,7 @@ class BranchHierarchy(LazyOrders):
                 continue
             boundary = system.boundaries[-which]  # the first boundary for the first piece, the last for the last
             length = boundary.point.value if which == 0 else system.pi_point.value - boundary.point.value
-            self._arc_data.append({"mu": [domain.one / (length * length)], "quotient": [-boundary.sine], "length": [length],
+            self._arc_data.append({"mu": [domain.one / (length * length)], "length": [length],
                                    "quotients": [[-boundary.sine if k == system.mode else domain.zero
                                                   for k in range(system.size)]]})
         self._resonant = Branch(domain, {(1, 1, 1): domain.one / domain.convert(2)})  # s sin s / 2 solves v'' + v = cos s
@@ -232,9 +231,9 @@ class BranchHierarchy(LazyOrders):
 
     @locked
     def release(self, order: int, component: int) -> Any:
-        """W_{order, component}(0) (on an N-dof first-piece arc: Y_{order, component}(0))."""
+        """W_{order, component}(0) (on a first-piece arc: Y_{order, component}(0))."""
         branches = self.branches(order)
-        if isinstance(self.system.arcs[0], VectorArc):
+        if self.system.arcs[0] is not None:
             return self._domain.dtype(self.system.arcs[0].release(order, component))
         return branches[0][component].evaluate(self.system.zero_point)
 
@@ -262,8 +261,7 @@ class BranchHierarchy(LazyOrders):
         )
         self._ensure(highest + self._lag)
         shifts = tuple(tuple(to_float(value) for value in self.boundary_shift(n)) for n in range(highest + 1))
-        arcs = tuple(None if arc is None else arc.float_arcs(highest) if isinstance(arc, VectorArc)
-                     else arc.float_arc(highest) for arc in self.system.arcs)
+        arcs = tuple(None if arc is None else arc.float_arcs(highest) for arc in self.system.arcs)
         return FloatBranches(terms, shifts, arcs)
 
     def _law_power(self, piece: int, element: int, power: int, order: int) -> Branch:
@@ -370,7 +368,7 @@ class BranchHierarchy(LazyOrders):
 
     # -- one order -------------------------------------------------------------------------------------
     def _solve_order(self, order: int) -> None:
-        """Order ``order``: every component when the system is coupled (a stretched arc, N = 1); otherwise
+        """Order ``order``: every component when the system is coupled (N = 1, or a stretched arc); otherwise
         only the mode component j (A_n and W_{n,j}) — the components k ≠ j and the shifts σ_n are
         solved by :meth:`_complete` when something asks for them (order n + 1, branches, shifts)."""
         self._complete(order - 1)
@@ -414,15 +412,11 @@ class BranchHierarchy(LazyOrders):
         size = len(components)
         resonant = self._resonant
         top, bottom = system.arcs
-        # A_n, then c_k on the first piece for every component k (σ_{1,n} with a first-piece arc),
-        # then h_n with a last-piece arc; an N-dof first-piece arc (VectorArc): A_n, σ_{1,n}, the release
-        # values h_k (k ≠ j) and μ_n
-        vector = isinstance(top, VectorArc)
-        vector_bottom = isinstance(bottom, VectorArc)
-        # an N-dof last-piece arc adds its far turning values h_k (every k) and μ_n at bottom_base …
-        bottom_base = size + 1 + vector
-        unknown_count = size + 1 + (bottom is not None) + vector + (size if vector_bottom else 0)
-        turning = size + 1
+        # A_n, then c_k on the first piece for every component k; with a first-piece arc: A_n, σ_{1,n}, the
+        # release values h_k (k ≠ j) and μ_n; a last-piece arc adds its far turning values h_k (every k) and μ_n
+        # at bottom_base …
+        bottom_base = size + 1 + (top is not None)
+        unknown_count = bottom_base + (size + 1 if bottom is not None else 0)
 
         def constant(value: Any) -> _Affine:
             return _Affine(value, [zero] * unknown_count)
@@ -491,15 +485,9 @@ class BranchHierarchy(LazyOrders):
             point = boundary.point
             powers = self._shift_powers(index, order)
             left, right = index, index + 1
-            if index == 0 and vector:
-                c_next, d_next, top_quotient, contact = self._match_first_vector_arc(
-                    order, point, boundary, powers, value_of, constant, unit)
-                c_values.append(c_next)
-                d_values.append(d_next)
-                shift_values.append(unit(1))
-                continue
             if index == 0 and top is not None:
-                c_next, d_next, top_quotient = self._match_first_arc(order, point, boundary, powers, value_of, constant, unit)
+                c_next, d_next, top_quotient, contact = self._match_first_arc(
+                    order, point, boundary, powers, value_of, constant, unit)
                 c_values.append(c_next)
                 d_values.append(d_next)
                 shift_values.append(unit(1))
@@ -544,26 +532,16 @@ class BranchHierarchy(LazyOrders):
         last = last_piece
         if bottom is None:
             equations = [value_of(last, p, c_values[last][p], d_values[last][p], system.pi_point, True) for p in range(size)]
-        elif vector_bottom:
-            index = len(system.boundaries) - 1
-            equations, bottom_mu, bottom_quotient = self._match_last_vector_arc(
-                order, index, shift_values[index], value_of, c_values[last - 1], d_values[last - 1], constant, unit,
-                bottom_base)
         else:
             index = len(system.boundaries) - 1
-            bottom_mu, bottom_quotient, slope_condition = self._match_last_arc(
-                order, system.boundaries[index], self._shift_powers(index, order), shift_values[index],
-                value_of(last - 1, 0, c_values[last - 1][0], d_values[last - 1][0], system.boundaries[index].point, True),
-                constant, unit(turning),
-            )
-            equations = [slope_condition, self._arc_frequency_condition(1, order, bottom_mu, shift_values[index].scale(-domain.one), unit)]
+            equations, bottom_mu, bottom_quotient = self._match_last_arc(
+                order, index, shift_values[index], value_of, c_values[last - 1], d_values[last - 1], constant, unit,
+                bottom_base)
         if mode not in components:
             equations.append(unit(0).shift(-self._squared[order]))  # A_n is known: solved with the mode component
-        elif vector:  # the arc's end on its breakpoint, and A_n = [μ s_1*²]_n
+        elif top is not None:  # the arc's end on its breakpoint, and A_n = [μ s_1*²]_n
             equations.append(contact)
             equations.append(self._arc_frequency_condition(0, order, unit(size + 1), unit(1), unit))
-        elif top is not None:  # the release is the arc's; the unknowns are tied by A_n = [μ s_1*²]_n
-            equations.append(self._arc_frequency_condition(0, order, constant(self._arc_data[0]["mu"][order]), unit(1), unit))
         elif self.normalization == "initial":
             position = components.index(mode)
             release = value_of(0, position, c_values[0][position], d_values[0][position], system.zero_point, False)
@@ -599,7 +577,7 @@ class BranchHierarchy(LazyOrders):
         for shifts, value in zip(self._shifts, shift_values):
             if value is not None:
                 shifts.append(value.value(unknowns))
-        if vector:
+        if top is not None:
             data = self._arc_data[0]
             mu = unknowns[size + 1]
             data["mu"].append(mu)
@@ -609,21 +587,12 @@ class BranchHierarchy(LazyOrders):
             heights = [self._arc_height(k, unit).value(unknowns) if k != mode else
                        (zero if release is None else release) for k in range(size)]
             top.fix(order, heights, mu)
-        elif top is not None:
-            self._arc_data[0]["quotient"].append(top_quotient.value(unknowns))
-            self._arc_data[0]["length"].append(unknowns[1])
-        if vector_bottom:
+        if bottom is not None:
             data = self._arc_data[1]
             data["mu"].append(bottom_mu.value(unknowns))
             data["quotients"].append([q.value(unknowns) for q in bottom_quotient])
             data["length"].append(-self._shifts[-1][order])
             bottom.fix(order, [unknowns[bottom_base + k] for k in range(size)], unknowns[bottom_base + size])
-        elif bottom is not None:
-            data = self._arc_data[1]
-            data["mu"].append(bottom_mu.value(unknowns))
-            data["quotient"].append(bottom_quotient.value(unknowns))
-            data["length"].append(-self._shifts[-1][order])
-            bottom.fix(order, unknowns[turning])
 
     def _projections(self, order: int, piece: int, state: ContactState, previous: list[Branch]) -> list[Branch]:
         """c · W_{n−gauge} on ``piece`` for every rank-one term (c, g) of the piece's law, formed once per order."""
@@ -634,38 +603,15 @@ class BranchHierarchy(LazyOrders):
             self._projection_cache[key] = [_combination(self._domain, previous, coupling) for _, coupling in state.rank_one]
         return self._projection_cache[key]
 
-    def _match_first_arc(self, order: int, point: EvaluationPoint, boundary: MovingBoundary, powers: list, value_of: Any, constant: Any, unit: Any) -> tuple:
-        """The next piece's homogeneous parts from the first arc's end: W(s*) = κ, W'(s*) = Y'(1)/s*, at order n.
-
-        The arc is released at its prescribed w_n, so μ_n and P_n = Y_n'(1) are numbers.  Unknowns:
-        A_n (index 0) and σ_n (index 1).  W_0 = cos s, so the σ_n terms at β are W_0'(β) σ_n = −sin β σ_n
-        (value) and W_0''(β) σ_n = −κ σ_n (slope); Q = Y'(1)/s* gives
-        Q_n = (P_n − Σ_{j=1}^{n−1} σ_j Q_{n−j} − σ_n Q_0)/β, Q_0 = −sin β.
-        """
-        domain, arc, data = self._domain, self.system.arcs[0], self._arc_data[0]
-        release = self.system.release_at(order)
-        arc.fix(order, domain.zero if release is None else release)
-        # RealField.dtype keeps every digit of an mpf (RealField.convert goes through a float)
-        data["mu"].append(domain.dtype(arc.mu(order)))
-        sine, cosine, beta = boundary.sine, point.cos_multiple(1), point.value
-        known_quotient = domain.dtype(arc.slope(order))
-        for j in range(1, order):
-            known_quotient = known_quotient - data["length"][j] * data["quotient"][order - j]
-        quotient = constant(known_quotient / beta) + unit(1).scale(sine / beta)
-        value = unit(1).scale(sine).shift(-self._known(0, 1, 0, order, 0, powers))
-        slope_target = (quotient + unit(1).scale(cosine)).shift(-self._known(0, 1, 0, order, 1, powers))
-        x = value - value_of(1, 0, constant(domain.zero), constant(domain.zero), point, False)
-        y = slope_target - value_of(1, 0, constant(domain.zero), constant(domain.zero), point, True)
-        return [x.scale(cosine) - y.scale(sine)], [x.scale(sine) + y.scale(cosine)], quotient
-
     def _arc_height(self, k: int, unit: Any) -> _Affine:
-        """The release value h_k (k ≠ j) of an N-dof first-piece arc among the order's unknowns."""
+        """The release value h_k (k ≠ j) of a first-piece arc among the order's unknowns."""
         position = k if k < self.system.mode else k - 1
         return unit(2 + position)
 
-    def _match_first_vector_arc(self, order: int, point: EvaluationPoint, boundary: MovingBoundary, powers: list,
-                                value_of: Any, constant: Any, unit: Any) -> tuple:
-        """:meth:`_match_first_arc` for N components (:class:`~lindstedt.engine.stretched.VectorArc`).
+    def _match_first_arc(self, order: int, point: EvaluationPoint, boundary: MovingBoundary, powers: list,
+                         value_of: Any, constant: Any, unit: Any) -> tuple:
+        """The next piece's homogeneous parts from the first arc's end (:class:`~lindstedt.engine.stretched.VectorArc`),
+        at order n.
 
         Unknowns: A_n (0), σ_n = ℓ_n (1), h_k = Y_{n,k}(0) for k ≠ j (2 …), μ_n (N + 1).  Every component's
         end value ``Y_{n,k}(1)`` and slope ``Q_k = Y_k'(1)/s*`` are affine in them; the next piece matches
@@ -706,9 +652,9 @@ class BranchHierarchy(LazyOrders):
             d_next.append(x.scale(sin_r) + y.scale(cos_r / ratio))
         return c_next, d_next, quotients, contact
 
-    def _match_last_vector_arc(self, order: int, index: int, shift: _Affine, value_of: Any, c_left: list, d_left: list,
-                               constant: Any, unit: Any, base: int) -> tuple:
-        """The matching of an N-dof last-piece arc (:class:`~lindstedt.engine.stretched.VectorArc`), at order n.
+    def _match_last_arc(self, order: int, index: int, shift: _Affine, value_of: Any, c_left: list, d_left: list,
+                        constant: Any, unit: Any, base: int) -> tuple:
+        """The matching of a last-piece arc (:class:`~lindstedt.engine.stretched.VectorArc`), at order n.
 
         On (s_L*, π] ``W_k(s) = −Y_k((π − s)/ℓ)``, ``ℓ = π − s_L*`` (``ℓ_n = −σ_{L,n}``, σ from the left piece's
         contact condition); unknowns ``h_k = Y_{n,k}(0)`` (``base + k``, the far turning values) and ``μ_n``
@@ -741,27 +687,6 @@ class BranchHierarchy(LazyOrders):
             equations.append(slope - quotient)
         equations.append(self._arc_frequency_condition(1, order, mu, shift.scale(-domain.one), unit))
         return equations, mu, quotients
-
-    def _match_last_arc(self, order: int, boundary: MovingBoundary, powers: list, shift: _Affine, left_slope: _Affine,
-                        constant: Any, turning: _Affine) -> tuple:
-        """μ_n and Q_n of the last arc (affine in its turning value h_n), and the slope condition at s_L*.
-
-        On the last piece W(s) = −Y((π − s)/ℓ), ℓ = π − s_L*, so W'(s_L*) = Y'(1)/ℓ = Q; ℓ_n = −σ_{L,n}.
-        The left piece's slope at the moving point is its W_n'(β) + known Taylor terms + W_0''(β) σ_n.
-        """
-        domain, arc, data = self._domain, self.system.arcs[1], self._arc_data[1]
-        mu_constant, mu_per_h, slope_constant, slope_per_h = (domain.dtype(value) for value in arc.response(order))
-        mu = constant(mu_constant) + turning.scale(mu_per_h)
-        slope = constant(slope_constant) + turning.scale(slope_per_h)
-        length = data["length"]
-        for j in range(1, order):
-            slope = slope.shift(-length[j] * data["quotient"][order - j])
-        # −ℓ_n Q_0 = σ_n Q_0 = −σ_n sin β
-        quotient = (slope + shift.scale(-boundary.sine)).scale(domain.one / length[0])
-        index = len(self.system.boundaries) - 1
-        left = left_slope.shift(self._known(index, len(self.system.states) - 2, 0, order, 1, powers))
-        left = left + shift.scale(-boundary.point.cos_multiple(1))
-        return mu, quotient, left - quotient
 
     def _arc_frequency_condition(self, which: int, order: int, mu: _Affine, length_shift: _Affine, unit: Any) -> _Affine:
         """A_n − [μ ℓ²]_n = 0 for arc ``which`` (μ = Ω²/ℓ²), given μ_n and ℓ_n as affine values."""

@@ -42,7 +42,7 @@ from ..problems.oscillator import DISPLACEMENT, Oscillator
 from ..algebra.branch import EvaluationPoint
 from ..algebra.contact_field import ContactField
 from .branches import BranchHierarchy, BranchSystem, ContactState, MovingBoundary
-from .stretched import StretchedArc
+from .stretched import VectorArc
 from .._precision import locked, workdps
 
 __all__ = ["ContactBoundary", "PiecewiseNormalForm", "contact_normal_form"]
@@ -308,7 +308,9 @@ def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hi
 
 def _stretched_arcs(problem: Oscillator, w_intervals: list, interval_of: list[int], fractional_pieces: list[int],
                     crossing_kappas: list[sympy.Expr], grazing: list, field: "_ConstantField") -> tuple:
-    """(first, last): the pieces with a fractional power law c |w − κ|^p as stretched arcs, or None.
+    """(first, last): the pieces with a fractional power law c |w − κ|^p (or an analytic law) as stretched arcs — the
+    one arc implementation, :class:`~lindstedt.engine.stretched.VectorArc`, with one component (coupling and force
+    direction (1,), the rest of the law one analytic expression of W) — or None.
 
     The first piece holds the release point w = 1, the last one the far turning point; there the arc is
     read backwards, Y = −W, whose law is −f̂(−Y) = −Σ c_m (−Y)^m − c (Y + κ)^p (contact point −κ).
@@ -356,8 +358,9 @@ def _stretched_arcs(problem: Oscillator, w_intervals: list, interval_of: list[in
         if analytic != 0:
             _check_analytic_on_arc(law, kappa, problem)
         power = None if exponent is None else Fraction(int(exponent.p), int(exponent.q))
-        arcs.append(StretchedArc(number(kappa), power, number(coefficient), field.digits,
-                                 None if law == 0 else (sympy.expand(law), _ARC_VARIABLE)))
+        rest = () if law == 0 else (((1,), (1,), (sympy.expand(law), _ARC_VARIABLE)),)  # g(y) acting on y = W
+        arcs.append(VectorArc((1,), 0, (1,), (1,), number(kappa), power, number(coefficient), ((0,), (), ()),
+                              field.digits, rest))
     return tuple(arcs)
 
 

@@ -174,14 +174,15 @@ class StretchedArcSeries(JsonExport):
 
 
 def arc_series(hierarchy: Any, arcs: tuple[Any, Any], highest: int) -> tuple[StretchedArcSeries, ...]:
-    """The stretched arcs of a piecewise hierarchy through order ``highest`` of the gauge (``arcs``: the engine's
-    arc at the release and at the far turning point, None where the piece is polynomial)."""
+    """The stretched arcs of a 1-dof piecewise hierarchy through order ``highest`` of the gauge (``arcs``: the
+    engine's one-component :class:`~lindstedt.engine.stretched.VectorArc` at the release and at the far turning point,
+    None where the piece is polynomial)."""
     result = []
     for which, arc in enumerate(arcs):
         if arc is None:
             continue
         lengths = tuple(hierarchy.arc_length(which, n) for n in range(highest + 1))  # mpf already: mpmath.mpf() would round to mp.prec
-        series = [arc.series(n) for n in range(highest + 1)]
+        series = [arc.series(n, arc.mode) for n in range(highest + 1)]  # the oscillator's one component
         result.append(StretchedArcSeries(
             side="release" if which == 0 else "far",
             sign=1 if which == 0 else -1,
