@@ -119,3 +119,16 @@ def test_precision_does_not_leak(cracked_beam):
     before = (mpmath.mp.prec, gmpy2.get_context().precision)
     ResidualFlexibility(modes=2, digits=20).reduce(beam)
     assert (mpmath.mp.prec, gmpy2.get_context().precision) == before
+
+
+def test_reducing_a_reduced_model_equals_the_direct_reduction(cracked_beam):
+    # span(Φ_8, Z_8) holds Φ_4 and K⁻¹W exactly, so its Galerkin 4-mode reduction is the full model's
+    beam, _ = cracked_beam
+    direct = ResidualFlexibility(modes=4).reduce(beam)
+    large = ResidualFlexibility(modes=8).reduce(beam).system
+    again = ResidualFlexibility(modes=4).reduce((large.M_exact, large.K_exact), A=large.A_exact, b=list(large.b),
+                                                W=large.W_exact)
+    assert again.system.n_dof == direct.system.n_dof == 5
+    first = lindstedt.nnm(direct.system, 1, a0=1, order=2).omega
+    second = lindstedt.nnm(again.system, 1, a0=1, order=2).omega
+    assert all(error < 1e-25 for error in _relative(second, first))

@@ -17,9 +17,12 @@ is a :class:`~lindstedt.problems.system.UnilateralSystem` of K + m dof with the 
 takes (strained coordinates, shooting, forced responses).  The truncation is a model reduction, not an exact
 step: ``ω₀`` and ``ω₁`` of an NNM of a kept mode are those of the full model to the working precision (the mode
 is in the basis), ``ω₂`` and beyond carry the truncation error.  Measured against the full 201-dof cracked
-cantilever (all 201 modes, 30 digits): ω₂ errs by 1e-3 (relative) with K = 2 modes alone and still 2e-4 with 32
-(the forces' quasi-static share is missing); with the residual vector, by 1e-10 at K = 2…8, 1e-13 at 12 and
-1e-15 at 32 (``tests/test_reduction.py`` fits the order).
+cantilever (all 201 modes, 30 digits), relative errors of ω₂: K modes alone 0.9 at K = 2 and still 0.22 at
+K = 32 (the forces' quasi-static share is missing); with the residual vector 1.5e-4 at K = 2, 3.5e-7 at K = 4…8
+(modes 5…8 add little: their curvature nearly vanishes at the crack), 1e-10 at 12, 2.4e-11 at 16, 1e-12 at 32
+(``tests/test_reduction.py``).  The error is mesh-dependent: 1.6e-6 at K = 4 and 8 on the 801-dof mesh
+(``benchmarks/bench_structures.py``); compare two K to judge it.  Reducing a reduced model again to K' < K modes
+gives the K'-reduction of the full model exactly (its basis spans K⁻¹W), so that comparison costs no large solve.
 
 **Precision.**  A float64 factorisation of a fine mesh loses ``eps · cond(K)`` (λ₁ of the float Lanczos
 modes is 1e-3 off at 10⁴ dof), so the basis is computed in multiprecision (gmpy2 ``mpfr`` at the working digits
