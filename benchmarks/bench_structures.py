@@ -78,12 +78,12 @@ FULL = {
     "shoot": {"beam": 50, "chain": 100},  # shooting up to this N
     "fe": [8, 16, 32, 64, 128, 256, 512, 1024, 2048, 5000],
     "phases": [200, 1000, 5000],
-    "forced": ["beam", "chain"],
+    "forced": ["beam", "chain", "beam_reduced4", "beam_reduced8"],
     "reduced": {"elements": [100, 400, 1000, 2500, 5000], "modes": [4, 8], "full_max": 801},  # full model up to N
 }
 QUICK = {"beam": [12, 24], "chain": [20, 50], "shoot": {"beam": 30, "chain": 20}, "fe": [8, 16, 32],
          "phases": [], "forced": ["chain10"], "reduced": {"elements": [8, 16], "modes": [2, 4], "full_max": 33}}
-PARTS = ("nnm", "phases", "forced", "reduced")  # what --only can run alone
+PARTS = ("nnm", "phases", "forced", "forced_reduced", "reduced")  # what --only can run alone
 
 
 # --------------------------------------------------------------------------------------------------- workers
@@ -317,7 +317,8 @@ def _worker_forced(model: str) -> dict[str, Any]:
     import sympy
 
     lindstedt = _imports()
-    if model == "beam":  # cantilever, 50 elements (N = 100), stops on both sides of the tip at distance 1
+    reduction = None
+    if model.startswith("beam"):  # cantilever, 50 elements (N = 100), stops on both sides of the tip at distance 1
         beam = lindstedt.EulerBernoulliBeam(50)
         exact = beam.system()
         tip = beam.index("w50")
@@ -325,18 +326,31 @@ def _worker_forced(model: str) -> dict[str, Any]:
         A[0, tip], A[1, tip] = 1, -1
         system = lindstedt.UnilateralSystem(M=exact.M_exact, K=exact.K_exact, A=A, b=[1, 1])
         where, epsilon, load_value = tip, 3.0, "1/15"
+        if model.startswith("beam_reduced"):  # K modes + the residual vectors of the stops and the load (one: all at the tip)
+            start = time.process_time()
+            shape = [sympy.Rational(load_value) if i == tip else 0 for i in range(beam.n_dof)]
+            reduction = lindstedt.ResidualFlexibility(modes=int(model[len("beam_reduced"):])).reduce(
+                (exact.M_exact, exact.K_exact), A=A, b=[1, 1], loads=shape)
+            reduction_cpu = time.process_time() - start
+            system = reduction.system
     else:  # string-scaled chain of 100 (chain10: 10) masses, the two stops of the nnm workload, gaps 1
         size = 10 if model == "chain10" else 100
         system = lindstedt.UnilateralSystem.chain(size, unilateral=[(size // 4, 1), (3 * size // 4, 1, -1)],
                                                   mass=f"1/{size + 1}", stiffness=size + 1)
         where, epsilon, load_value = size // 2, 10.0, "1/40"
     lam = system.modes().frequencies
-    load = [0] * system.n_dof
-    load[where] = load_value
+    if reduction is not None:
+        load = list(reduction.loads[0])
+    else:
+        load = [0] * system.n_dof
+        load[where] = load_value
     zeta = 0.01
     problem = lindstedt.ForcedSystem(system, load, rayleigh=(zeta * float(lam[0]), zeta / float(lam[0])))  # ζ₁ = 1 %
     out: dict[str, Any] = {"model": model, "n_dof": system.n_dof, "epsilon": epsilon, "load": f"{load_value} at dof {where}",
                            "lambda1": float(lam[0]), "lambda_max": float(lam[-1]), "start": 0.8, "stop": 1.5}
+    if reduction is not None:
+        out.update(n_dof=reduction.n_dof, reduced_dof=system.n_dof, reduction_cpu=reduction_cpu,
+                   reduction_message=reduction.message)
     start = time.process_time()
     try:
         response, cpu, status = _budgeted(
@@ -349,7 +363,7 @@ def _worker_forced(model: str) -> dict[str, Any]:
         out.update(success=bool(response.success), message=response.message[:200], points=len(response.points),
                    flow_evaluations=int(response.flow_evaluations), newton_iterations=int(response.newton_iterations),
                    bifurcations=[[b.kind, float(b.frequency) / float(lam[0])] for b in response.bifurcations],
-                   peak=float(np.max(np.abs(np.asarray(response.amplitudes)[:, where]))))
+                   peak=None if reduction is not None else float(np.max(np.abs(np.asarray(response.amplitudes)[:, where]))))
     return out
 
 
@@ -492,9 +506,12 @@ def run(quick: bool = False, only: str | None = None) -> str:
             outcome = run_worker(sys.executable, SELF, ["--worker", "phases", size, BUDGET / 2], timeout=3 * BUDGET + 60)
             data["phases"].append(outcome.result if outcome.status == "ok" else {"size": size, "status": outcome.status, "detail": outcome.detail})
             _log(f"phases n = {size}: {outcome.status}")
-    if only in (None, "forced"):
-        data["forced"] = []
+    if only in (None, "forced", "forced_reduced"):
+        kept = [f for f in data.get("forced", []) if not f["model"].startswith("beam_reduced")] if only == "forced_reduced" else []
+        data["forced"] = kept
         for model in plan["forced"]:
+            if only == "forced_reduced" and not model.startswith("beam_reduced"):
+                continue
             outcome = run_worker(sys.executable, SELF, ["--worker", "forced", model], timeout=5 * BUDGET + 60)
             data["forced"].append(outcome.result if outcome.status == "ok" else {"model": model, "status": outcome.status,
                                                                                  "detail": outcome.detail, "wall": outcome.wall})
@@ -601,6 +618,8 @@ def _markdown(data: dict[str, Any], quick: bool) -> str:
     if data.get("forced"):
         lines += ["**Forced response through the folds of mode 1** (`frequency_response(ForcedSystem(..., rayleigh=(ζλ₁, ζ/λ₁)), "
                   "0.8 λ₁, 1.5 λ₁, epsilon=ε)`, ζ₁ = 1 %)", "",
+                  "`beam_reducedK`: the beam reduced first by `ResidualFlexibility(modes=K).reduce((M, K), A, b, loads=P)` "
+                  "(K modes + one residual vector: the stops and the load act on one dof); CPU = reduction + response.", "",
                   "| model | N | ε, load | λ_max/λ₁ | CPU (s) | status | points | flow evaluations | bifurcations (Ω/λ₁) |",
                   "|---|---:|---|---:|---:|---|---:|---:|---|"]
         for f in data["forced"]:
@@ -611,8 +630,10 @@ def _markdown(data: dict[str, Any], quick: bool) -> str:
             status = f["status"] if f["status"] != "ok" else ("success" if f.get("success") else "failed: " + f.get("message", ""))
             if f["status"] == "refused":
                 status = "refused: " + f["message"][:260]
-            lines.append(f"| {f['model']} | {f['n_dof']} | {f['epsilon']:g}, {f['load']} | {f['lambda_max'] / f['lambda1']:.3g} | "
-                         f"{f['cpu']:.3g} | {status} | {f.get('points', '—')} | {f.get('flow_evaluations', '—')} | {bif} |")
+            size = f"{f['n_dof']} → {f['reduced_dof']}" if "reduced_dof" in f else f"{f['n_dof']}"
+            cpu = (f"{f['reduction_cpu']:.3g} + {f['cpu']:.3g}" if "reduction_cpu" in f else f"{f['cpu']:.3g}")
+            lines.append(f"| {f['model']} | {size} | {f['epsilon']:g}, {f['load']} | {f['lambda_max'] / f['lambda1']:.3g} | "
+                         f"{cpu} | {status} | {f.get('points', '—')} | {f.get('flow_evaluations', '—')} | {bif} |")
         lines.append("")
     lines += _targets(data)
     return "\n".join(lines)
@@ -687,7 +708,8 @@ def _targets(data: dict[str, Any]) -> list[str]:
     beam_text = (f"largest N within {data['budget_cpu_s']:.0f} s: {largest}"
                  + (f"; N = {stopped['n_dof']}: {stopped['status']}" if stopped else ""))
     forced = [f for f in data.get("forced", []) if f.get("n_dof") == 100]
-    forced_text = "; ".join(f"{f['model']}: " + (f"{f['cpu']:.0f} s CPU, {f['status']}" if f["status"] != "refused" else "refused before integrating")
+    forced_text = "; ".join(f"{f['model']}: " + (f"{f['cpu'] + f.get('reduction_cpu', 0.0):.2g} s CPU, {f['status']}"
+                                                  if f["status"] != "refused" else "refused before integrating")
                             for f in forced) or "not run"
     return ["**Issue targets, measured:**", "",
             f"- NNM order 2, cracked beam, N = 10⁴, in seconds with memory O(N·elements) — {beam_text} "
