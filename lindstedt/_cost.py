@@ -216,18 +216,22 @@ _NNM_MEMORY = (3.5e-4, 12.0)
 #: and order: 0.22 s at N = 5, order 1; 9.98 s at N = 20, order 3); products of branches (powers ≥ 2, analytic laws)
 #: cost ``_NNM_PRODUCTS · N^1.6 · 9^(order − 2)`` s from order 3 on (combination tones of the N modal frequencies:
 #: sin(u) with a crossing, 1.28 s at N = 5, order 3; 11.9 s at N = 5, order 4; 12.1 s at N = 20, order 3); order 2
-#: stays linear in N (0.77 s for a cubic spring at N = 200).
-_NNM_ARC, _NNM_PRODUCTS = 0.12, 0.015
+#: stays linear in N (0.77 s for a cubic spring at N = 200).  An analytic contact arc without a fractional power
+#: (Chebyshev series in 1 − τ itself, which converge on fewer nodes) costs ``_NNM_ANALYTIC_ARC · N · (order + 1)`` s
+#: (``Max(0, u - 1/5)*exp(u)`` on the middle mass of a chain with a gap spring, a0 = 3: 0.13 s at N = 5, order 1;
+#: 1.7 s at N = 20, order 2; 6.4 s at N = 40, order 3).
+_NNM_ARC, _NNM_ANALYTIC_ARC, _NNM_PRODUCTS = 0.12, 0.03, 0.015
 
 
-def _law_costs(system: Any) -> tuple[bool, bool]:
-    """(a law has a fractional power — a Hertz arc; a law multiplies branches — a piece of degree ≥ 2 or an analytic
-    part), read from the laws' pieces."""
+def _law_costs(system: Any) -> tuple[float, bool]:
+    """(the seconds per dof and order of a stretched contact arc — a law with a fractional power, or an analytic part
+    next to a breakpoint; 0 without one — and whether a law multiplies branches — a piece of degree ≥ 2 or an
+    analytic law without breakpoints), read from the laws' pieces."""
     from ._errors import LindstedtError
     from .problems.piecewise_linear import decompose_piecewise
     from .problems.system import LAW_VARIABLE, UNILATERAL
 
-    fractional = products = False
+    arc, products = 0.0, False
     for law in set(getattr(system, "laws", ())):
         if law == UNILATERAL:
             continue
@@ -235,9 +239,14 @@ def _law_costs(system: Any) -> tuple[bool, bool]:
             intervals = decompose_piecewise(law, LAW_VARIABLE)
         except LindstedtError:  # refused by the method itself, with its own words
             continue
-        fractional = fractional or any(interval.fractional for interval in intervals)
-        products = products or any(len(interval.coefficients) > 2 or interval.analytic != 0 for interval in intervals)
-    return fractional, products
+        if any(interval.fractional for interval in intervals):
+            arc = _NNM_ARC
+        elif len(intervals) > 1 and any(interval.analytic != 0 for interval in intervals):
+            arc = max(arc, _NNM_ANALYTIC_ARC)
+        # an analytic part next to a breakpoint multiplies on its arc (priced above), one without breakpoints branches
+        products = products or any(len(interval.coefficients) > 2 for interval in intervals) or \
+            (len(intervals) == 1 and intervals[0].analytic != 0)
+    return arc, products
 
 
 def nnm_estimate(system: Any, mode: int, order: int) -> Estimate:
@@ -245,9 +254,8 @@ def nnm_estimate(system: Any, mode: int, order: int) -> Estimate:
     n, springs = system.n_dof, max(len(system.b), 1)
     constant, per_dof, per_spring, per_order = _NNM
     seconds = math.exp(constant) * n**per_dof * springs**per_spring * (order + 1) ** per_order
-    fractional, products = _law_costs(system)
-    if fractional:
-        seconds += _NNM_ARC * n * (order + 1)
+    arc, products = _law_costs(system)
+    seconds += arc * n * (order + 1)
     if products and order >= 3:
         seconds += _NNM_PRODUCTS * n**1.6 * 9.0 ** (order - 2)
     memory = max(1.0, _NNM_MEMORY[0] * n * n, _NNM_MEMORY[1] * seconds**0.9)

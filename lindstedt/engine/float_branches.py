@@ -28,7 +28,7 @@ class FloatBranches:
 
     terms: tuple
     shifts: tuple
-    arcs: tuple[Any, Any] = (None, None)  # FloatArc (a tuple per component for N dof) of the first / last piece
+    arcs: tuple[Any, Any] = (None, None)  # per component, the FloatArcs of the first / last piece (or None)
 
     @cached_property
     def _arrays(self) -> tuple[np.ndarray, list[list[list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]]]]:
@@ -71,15 +71,15 @@ class FloatBranches:
                 if not np.any(mask):
                     continue
                 points = folded[mask]
-            if piece == 0 and self.arcs[0] is not None:  # Y(s/s_1*), one FloatArc per component for N dof
+            if piece == 0 and self.arcs[0] is not None:  # Y(s/s_1*), one FloatArc per component
                 length = weights @ shifts[:, 0]
-                for component, arc in enumerate(self.arcs[0] if isinstance(self.arcs[0], tuple) else (self.arcs[0],)):
+                for component, arc in enumerate(self.arcs[0]):
                     values = arc.evaluate(points / length, weights, derivative)
                     result[mask, component] = values * sign[mask] / length if derivative else values
                 continue
             if piece == len(pieces) - 1 and self.arcs[1] is not None:  # −Y((π − s)/(π − s_L*)), per component
                 length = np.pi - weights @ shifts[:, -1]
-                for component, arc in enumerate(self.arcs[1] if isinstance(self.arcs[1], tuple) else (self.arcs[1],)):
+                for component, arc in enumerate(self.arcs[1]):
                     values = arc.evaluate((np.pi - points) / length, weights, derivative)
                     result[mask, component] = values * sign[mask] / length if derivative else -values
                 continue

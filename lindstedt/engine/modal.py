@@ -32,10 +32,15 @@ of [0, π] a sample angle picks each element's polynomial ``Σ_m c_m u^m``.  In 
 ``f_i(a0 y − b_i)/a0 = Σ_l e_l y^l`` (binomial expansion): ``e_0`` joins the load, ``e_1`` the rank-one stiffness
 ``e_1 G_i B_iᵀ`` and the powers ``l ≥ 2`` act on the deformation ``y`` with the force direction ``G_i``
 (``ContactState.elements``: products of branches).  Unilateral springs are the case ``f = (·)_+``, one breakpoint 0.
-A fractional power ``c |u − p|^q`` (Hertz) on the contact interval that holds a turning point makes the first
-(release) or the last (far turning point) piece a stretched arc (:class:`~lindstedt.engine.stretched.VectorArc`; the
-far one in ``Y = −W``, ``τ = (π − s)/(π − s_L*)``); in contact along the whole orbit it is analytic there, and
-expanded as such.
+An element whose deformation stays between two breakpoints along the whole orbit may carry an analytic part ``f_a``
+(``sin(u)``), and a fractional power ``c |u − p|^q`` is analytic there too: both are expanded along the orbit
+(:class:`_AnalyticElement`).  On an element that crosses a breakpoint, a non-polynomial law — a fractional power
+(Hertz), an analytic part (``Max(0, u − p) e^u``) or both — must sit on the contact interval that holds a turning
+point: it makes the first (release) or the last (far turning point) piece a stretched arc
+(:class:`~lindstedt.engine.stretched.VectorArc`; the far one in ``Y = −W``, ``τ = (π − s)/(π − s_L*)``), on which its
+analytic part and those of the other elements act as ``h(y) = f_a(a0 y − b_i)/a0`` of their deformations ``y``,
+Taylor-expanded about the order-zero ones.  Anything else (such a law mid-orbit or on both sides of a breakpoint,
+contacts around both turning points, grazing) is refused with a typed error naming shooting.
 """
 
 from __future__ import annotations
@@ -298,21 +303,20 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
         """Whether the orbit crosses (or grazes) a breakpoint of element i's law."""
         return i in crossed_elements
 
+    def non_polynomial(i: int, interval: int, fractional: bool = True) -> sympy.Expr:
+        """Element i's analytic part on one interval of its law, in u; with ``fractional``, plus its terms
+        c |u − p|^q on the side of p the orbit stays on (analytic there)."""
+        return laws[i].analytic[interval] + sum(
+            (c * (side * (LAW_VARIABLE - point)) ** q for c, point, q, side in laws[i].exact_fractional[interval]),
+            sympy.S.Zero) if fractional else laws[i].analytic[interval]
+
     def analytic_element(i: int, interval: int) -> _AnalyticElement:
-        """Element i's analytic part on one interval of its law; the deformation must stay inside the interval
-        along the whole orbit (no breakpoint of that element crossed: the Taylor series about y_0(s) holds on
-        every piece)."""
+        """Element i's analytic part on one interval of its law; its deformation stays inside the interval along
+        the whole orbit (no breakpoint of that element crossed: the Taylor series about y_0(s) holds on every
+        piece)."""
         key = (i, interval)
         if key not in analytic_elements:
-            if moved_across(i):
-                raise UnsupportedNonlinearityError(
-                    f"the N-dof strained-coordinates NNM takes an analytic law ({system.laws[i]}) on an element whose "
-                    "deformation stays between two breakpoints of its law along the orbit; element "
-                    f"{i + 1} crosses one: compute its NNMs by shooting (nnm_point, continue_nnm)")
-            expression = laws[i].analytic[interval] + sum(  # c |u − p|^q on the side of p the orbit stays on
-                (c * (side * (LAW_VARIABLE - point)) ** q for c, point, q, side in laws[i].exact_fractional[interval]),
-                sympy.S.Zero)
-            analytic_elements[key] = _AnalyticElement(system.laws[i], expression, amplitude,
+            analytic_elements[key] = _AnalyticElement(system.laws[i], non_polynomial(i, interval), amplitude,
                                                       coupling_rows[i][mode], list(system.b_exact)[i], domain, digits)
         return analytic_elements[key]
 
@@ -344,22 +348,26 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
         if bottom:
             samples.append(samples[-1])
             flipped.append({s.index for s in bottom})
-        states, fractional = [], []
+        # per piece, the (element, interval) of the non-polynomial laws: on an element that crosses a breakpoint
+        # (a stretched arc's law), or one whose deformation stays inside an interval (expanded along the orbit)
+        states, arc_laws, whole_orbit = [], [], []
         for piece, (middle, flips) in enumerate(zip(samples, flipped)):
             cosine = middle.context.cos(middle)
             load = [domain.zero] * size
             rank_one, elements, analytic = [], [], []
+            whole_orbit.append([])
             flipped_springs = [springs[index] for index in flips]  # the grazed breakpoints this piece lies beyond
             for i, law in enumerate(laws):
                 interval = law.interval(a0 * B[i][mode] * cosine - gaps[i])
                 for spring in flipped_springs:
                     if spring.element == i:  # across the grazed breakpoint
                         interval = spring.breakpoint + 1 if interval == spring.breakpoint else spring.breakpoint
-                if law.fractional and law.fractional[interval] and moved_across(i):
-                    fractional.append((piece, i, interval))
-                elif law.analytic[interval] != 0 or law.fractional[interval]:
-                    # a fractional term in contact along the whole orbit is analytic there: expanded like one
-                    analytic.append((forcing_columns[i], coupling_vectors[i], analytic_element(i, interval)))
+                if law.analytic[interval] != 0 or law.fractional[interval]:
+                    if moved_across(i):
+                        arc_laws.append((piece, i, interval))
+                    else:  # a fractional term in contact along the whole orbit is analytic there: expanded like one
+                        analytic.append((forcing_columns[i], coupling_vectors[i], analytic_element(i, interval)))
+                        whole_orbit[piece].append((i, interval))
                 constant, linear, powers = element_law(i, interval)
                 if constant:
                     for k in range(size):
@@ -371,7 +379,7 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
                     elements.append((forcing_columns[i], coupling_vectors[i], powers))
             states.append(ContactState((), tuple(load), elements=tuple(elements), rank_one=tuple(rank_one),
                                        analytic=tuple(analytic)))
-        arcs = _contact_arc(fractional, states, crossing, boundaries, crossed) if fractional else (None, None)
+        arcs = _contact_arc(arc_laws, whole_orbit, states, crossing, boundaries, crossed) if arc_laws else (None, None)
         return BranchSystem(
             domain=domain,
             ratios=tuple(None if k == mode else ratio for k, ratio in enumerate(ratios)),
@@ -385,45 +393,68 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
             arcs=arcs,
         )
 
-    def _contact_arc(fractional: list, states: list, crossing: list, boundaries: list,
+    def _contact_arc(arc_laws: list, whole_orbit: list, states: list, crossing: list, boundaries: list,
                      crossed: dict) -> tuple[VectorArc | None, VectorArc | None]:
-        """The first or the last piece as a stretched arc: one element's fractional (Hertz) term in contact around
-        a turning point (the release, or the far one), ending where that element's deformation reaches the term's
-        breakpoint (the first, or the last, boundary)."""
-        supported = ("the N-dof strained-coordinates NNM takes a fractional power law (Hertz) on one element whose "
-                     "contact holds a turning point and ends at the first or the last contact angle, without grazing")
-        piece, i, interval = fractional[0]
+        """The first or the last piece as a stretched arc: one element's non-polynomial law — a fractional (Hertz)
+        term, an analytic part or both — in contact around a turning point (the release, or the far one), ending where
+        that element's deformation reaches the breakpoint of its contact interval (the first, or the last,
+        boundary).  The analytic laws of the other elements on that piece act on the arc too."""
+        supported = ("the N-dof strained-coordinates NNM takes a fractional power (Hertz) or analytic law on one "
+                     "element whose contact holds a turning point and ends at the first or the last contact angle, "
+                     "without grazing")
+        piece, i, interval = arc_laws[0]
         last = len(states) - 1
-        if len(fractional) != 1 or piece not in (0, last) or crossed or not crossing or \
-                len(laws[i].fractional[interval]) != 1 or (piece == 0 and last == 0):
+        fractional = laws[i].fractional[interval]
+        if len(arc_laws) != 1 or piece not in (0, last) or crossed or not crossing or len(fractional) > 1 or last == 0:
             raise UnsupportedNonlinearityError(
                 f"{supported}; element {i + 1} ({system.laws[i]}) is not in contact around one turning point only: "
                 "compute its NNMs by shooting (nnm_point, continue_nnm)")
-        c, point, exponent = laws[i].fractional[interval][0]
         spring = crossing[0] if piece == 0 else crossing[-1]
-        if spring.element != i or laws[i].breakpoints[spring.breakpoint] != point:
+        if spring.element != i or (fractional and fractional[0][1] != laws[i].breakpoints[spring.breakpoint]):
             raise UnsupportedNonlinearityError(
                 f"{supported}; another breakpoint is crossed inside element {i + 1}'s contact arc: compute its NNMs "
                 "by shooting (nnm_point, continue_nnm)")
-        if states[piece].analytic:
-            raise UnsupportedNonlinearityError(
-                f"{supported}; an analytic law acts on element {i + 1}'s contact arc too: compute its NNMs by shooting "
-                "(nnm_point, continue_nnm)")
-        boundary = boundaries[0] if piece == 0 else boundaries[-1]
-        chi = boundary.coupling
-        coefficient = c * abs(chi[mode]) ** domain.convert(sympy.Rational(exponent.numerator, exponent.denominator)) / a0
+        end, far = laws[i].breakpoints[spring.breakpoint], piece == last
+        # the analytic laws on the arc as h(y) = f(a0 y − b)/a0 of the deformation y = c·W (c·Y on the arc); the
+        # contact element's must be analytic on the deformations it takes there, from its breakpoint to the turning
+        # point (the arc's own check sees its interior nodes only)
+        own = non_polynomial(i, interval, fractional=False)
+        if own != 0:
+            reach = sorted(domain.to_sympy(value) for value in (end, (-a0 if far else a0) * B[i][mode] - gaps[i]))
+            try:
+                continuous = sympy.calculus.util.continuous_domain(own, LAW_VARIABLE, sympy.Interval(*reach))
+            except (NotImplementedError, TypeError, ValueError):  # undecided: the arc's own finiteness check decides
+                continuous = sympy.Interval(*reach)
+            if continuous != sympy.Interval(*reach):
+                raise UnsupportedNonlinearityError(
+                    f"element {i + 1}'s law {system.laws[i]} is not analytic on its whole contact arc (u from "
+                    f"{sympy.N(reach[0], 6)} to {sympy.N(reach[1], 6)}); a non-polynomial piece must be analytic up to "
+                    "its breakpoint: compute its NNMs by shooting (nnm_point, continue_nnm)")
+        deformation = sympy.Symbol("y", real=True)
+        analytic = []
+        for e, law in [(i, own)] + [(e, non_polynomial(e, k)) for e, k in whole_orbit[piece]]:
+            if law != 0:
+                law = law.subs(LAW_VARIABLE, amplitude * deformation - list(system.b_exact)[e]) / amplitude
+                if far:  # Y = −W: the law −h(−y)
+                    law = -law.subs(deformation, -deformation)
+                analytic.append((forcing_columns[e], coupling_vectors[e], (sympy.expand(law), deformation)))
+        chi = (boundaries[-1] if far else boundaries[0]).coupling
+        exponent, coefficient = None, domain.zero
+        if fractional:
+            c, _, exponent = fractional[0]
+            coefficient = c * abs(chi[mode]) ** domain.convert(sympy.Rational(exponent.numerator, exponent.denominator)) / a0
         state = states[piece]
         rows = [domain.one if k == mode else ratio for k, ratio in enumerate(ratios)]
-        if piece == 0:
+        if not far:
             return VectorArc(rows, mode, chi, forcing_columns[i], spring.kappa, exponent, coefficient,
-                             (state.load, state.rank_one, state.elements), digits), None
+                             (state.load, state.rank_one, state.elements), digits, analytic), None
         # the far arc in Y = −W, τ = (π − s)/ℓ: F̃(Y) = −F(−Y) flips the load, the Hertz force and the odd powers'
         # signs of the even powers; the deformation's coupling is −χ and its contact point cos(π − β) = −κ
         flipped = tuple((g, c_, tuple((m, value if m % 2 else -value) for m, value in powers))
                         for g, c_, powers in state.elements)
         polynomial = (tuple(-x for x in state.load), state.rank_one, flipped)
         return None, VectorArc(rows, mode, tuple(-x for x in chi), tuple(-g for g in forcing_columns[i]), -spring.kappa,
-                               exponent, coefficient, polynomial, digits)
+                               exponent, coefficient, polynomial, digits, analytic)
 
     branch_system = assemble({})
     crossed = {}
