@@ -178,3 +178,26 @@ def test_loads_of_the_wrong_shape_are_refused(cracked_beam):
     beam, _ = cracked_beam
     with pytest.raises(lindstedt.ProblemError, match="one row per degree of freedom"):
         ResidualFlexibility(modes=2).reduce(beam, loads=[1, 2, 3])
+
+
+@pytest.mark.parametrize("matrices, match", [
+    (lambda M, K: (M, K + np.triu(K, 1)), "K is not symmetric"),
+    (lambda M, K: (M - 2 * np.diag(np.diag(M)), K), "M in the structure must be positive definite"),
+    (lambda M, K: (M, sympy.Matrix(K) * sympy.Symbol("k")), "must be a real number"),
+    (lambda M, K: (M, K.astype(object)), "must be a real numeric matrix"),
+])
+def test_bad_matrices(matrices, match):
+    chain = UnilateralSystem.chain(8, unilateral=[(2, 0)])
+    M = np.array(chain.M_exact.tolist(), dtype=float)
+    K = np.array(chain.K_exact.tolist(), dtype=float)
+    with pytest.raises(lindstedt.ProblemError, match=match):
+        ResidualFlexibility(modes=2).reduce(matrices(M, K), A=np.array(chain.A_exact.tolist(), dtype=float))
+
+
+def test_irrational_exact_entries_keep_the_working_precision():
+    # K = √2 · (chain stiffness): every λ_k scales by 2^(1/4) exactly
+    chain = UnilateralSystem.chain(8, unilateral=[(2, 0)])
+    scaled = ResidualFlexibility(modes=3).reduce((chain.M_exact, chain.K_exact * sympy.sqrt(2)), A=chain.A_exact)
+    plain = ResidualFlexibility(modes=3).reduce((chain.M_exact, chain.K_exact), A=chain.A_exact)
+    for a, b in zip(scaled.frequencies, plain.frequencies):
+        assert abs(a / b - mpmath.root(2, 4)) < mpmath.mpf(10) ** -28

@@ -14,7 +14,9 @@ Galerkin (Rayleigh–Ritz) projection
     ``(VᵀMV) q'' + (VᵀKV) q + ε Σ_i (Vᵀ w_i) f_i((a_iᵀ V) q − b_i) = 0``
 
 is a :class:`~lindstedt.problems.system.UnilateralSystem` of K + m dof with the same laws, which every engine
-takes (strained coordinates, shooting, forced responses).  The truncation is a model reduction, not an exact
+takes (strained coordinates, shooting, forced responses).  A forced problem's load shapes ``P`` join ``W`` in the
+static residuals (``Z = K⁻¹[W, P] − …``), and ``Vᵀ P`` is the reduced load; residual vectors that the kept modes
+and one another already span are dropped (two stops on one dof, a load on a contact dof).  The truncation is a model reduction, not an exact
 step: ``ω₀`` and ``ω₁`` of an NNM of a kept mode are those of the full model to the working precision (the mode
 is in the basis), ``ω₂`` and beyond carry the truncation error.  Measured against the full 201-dof cracked
 cantilever (all 201 modes, 30 digits), relative errors of ω₂: K modes alone 0.9 at K = 2 and still 0.22 at
@@ -37,6 +39,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from fractions import Fraction
 from typing import Any
 
 import mpmath
@@ -62,26 +65,38 @@ def _gmpy2() -> Any:
     return gmpy2
 
 
-def _rational(value: Any) -> Any:
-    """An exact number (sympy, int, float, Fraction) as a gmpy2 mpq, or an mpfr at the current precision."""
+def _rational(value: Any, name: str = "an entry") -> Any:
+    """An exact number (int, float, Fraction, sympy number) as a gmpy2 mpq, or a real sympy number kept as it is
+    (an irrational entry, rounded by :func:`_mpfr` at the working precision)."""
     gmpy2 = _gmpy2()
+    if isinstance(value, (bool, np.bool_)):
+        raise ProblemError(f"{name} must be a real number, got {value!r}")
     if isinstance(value, (int, np.integer)):
         return gmpy2.mpq(int(value))
     if isinstance(value, (float, np.floating)):
+        if not np.isfinite(value):
+            raise ProblemError(f"{name} must be finite, got {value!r}")
         return gmpy2.mpq(float(value))
-    value = sympy.sympify(value)  # already an exact sympy number here (from the problem's own matrices)
-    if value.is_Rational:
-        return gmpy2.mpq(int(value.p), int(value.q))
-    return gmpy2.mpfr(str(sympy.N(value, int(gmpy2.get_context().precision * 0.302) + 5)))
+    if isinstance(value, Fraction):
+        return gmpy2.mpq(value.numerator, value.denominator)
+    if isinstance(value, sympy.Basic) and value.is_number and value.is_real and value.is_finite:
+        return gmpy2.mpq(int(value.p), int(value.q)) if value.is_Rational else value
+    raise ProblemError(f"{name} must be a real number (int, float, Fraction or a sympy number), got {value!r:.60}")
+
+
+def _mpfr(value: Any) -> Any:
+    """An entry of :func:`_rational` as an mpfr at the current gmpy2 precision."""
+    gmpy2 = _gmpy2()
+    if isinstance(value, sympy.Basic):
+        return gmpy2.mpfr(str(sympy.N(value, int(gmpy2.get_context().precision * 0.302) + 5)))
+    return gmpy2.mpfr(value)
 
 
 def _entries(matrix: Any, rows: int, cols: int, name: str) -> dict[tuple[int, int], Any]:
     """The nonzero entries ``(i, j) -> exact value`` of a scipy.sparse, numpy or sympy matrix of shape (rows, cols)."""
     import scipy.sparse
 
-    if isinstance(matrix, dict):
-        pairs = matrix.items()
-    elif isinstance(matrix, sympy.MatrixBase):
+    if isinstance(matrix, sympy.MatrixBase):
         if matrix.shape != (rows, cols):
             raise ProblemError(f"{name} is {matrix.shape[0]}×{matrix.shape[1]}, expected {rows}×{cols}")
         pairs = matrix.todok().items()
@@ -95,13 +110,22 @@ def _entries(matrix: Any, rows: int, cols: int, name: str) -> dict[tuple[int, in
             coo = scipy.sparse.coo_matrix(np.atleast_2d(array).astype(float))
         if coo.shape != (rows, cols):
             raise ProblemError(f"{name} is {coo.shape[0]}×{coo.shape[1]}, expected {rows}×{cols}")
-        if not np.all(np.isfinite(coo.data)):
-            raise ProblemError(f"{name} has a non-finite entry; give finite numbers")
-        pairs = {}
+        if np.iscomplexobj(coo.data) or not np.all(np.isfinite(coo.data)):
+            raise ProblemError(f"{name} has a complex or non-finite entry; give finite real numbers")
+        summed: dict[tuple[int, int], float] = {}
         for i, j, v in zip(coo.row.tolist(), coo.col.tolist(), coo.data.tolist()):
-            pairs[i, j] = pairs.get((i, j), 0.0) + v
-        pairs = pairs.items()
-    return {key: _rational(value) for key, value in pairs if value != 0}
+            summed[i, j] = summed.get((i, j), 0.0) + v
+        pairs = summed.items()
+    return {key: _rational(value, f"{name}[{key[0]}, {key[1]}]") for key, value in pairs if value != 0}
+
+
+def _check_symmetric(entries: dict[tuple[int, int], Any], name: str) -> None:
+    """Refuse a matrix whose entries (i, j) and (j, i) differ by more than 1e-12 of its largest entry."""
+    largest = max((abs(float(value)) for value in entries.values()), default=0.0)
+    for (i, j), value in entries.items():
+        if i < j and abs(float(value) - float(entries.get((j, i), 0))) > 1e-12 * largest:
+            raise ProblemError(f"{name} is not symmetric: entries ({i}, {j}) and ({j}, {i}) differ; give the full "
+                               f"symmetric matrix (not one triangle), or ({name} + {name}ᵀ)/2 if the difference is rounding")
 
 
 class _BandedLDL:
@@ -124,7 +148,7 @@ class _BandedLDL:
         for (i, j), value in entries.items():
             p, q = int(position[i]), int(position[j])
             if q <= p:
-                rows[p][q] = gmpy2.mpfr(value)
+                rows[p][q] = _mpfr(value)
                 width = max(width, p - q)
         self.width = width
         lower: list[list[tuple[int, Any]]] = []
@@ -196,12 +220,11 @@ class _SparseProduct:
     """``S @ columns`` for exact sparse entries, in mpfr, grouped by diagonal (vectorised over rows)."""
 
     def __init__(self, entries: dict[tuple[int, int], Any], n: int) -> None:
-        gmpy2 = _gmpy2()
         by_offset: dict[int, tuple[list[int], list[Any]]] = {}
         for (i, j), value in entries.items():
             rows, values = by_offset.setdefault(j - i, ([], []))
             rows.append(i)
-            values.append(gmpy2.mpfr(value))
+            values.append(_mpfr(value))
         self.diagonals = []
         for offset, (rows, values) in by_offset.items():
             order = np.argsort(rows)
@@ -371,6 +394,8 @@ class ResidualFlexibility:
             n = int(shape[0])
             mass = _entries(structure[0], n, n, "M")
             stiffness = _entries(structure[1], n, n, "K")
+            _check_symmetric(mass, "M")
+            _check_symmetric(stiffness, "K")
             rows_A = getattr(A, "shape", None) or np.shape(np.asarray(A, dtype=object))
             m = int(rows_A[0]) if len(rows_A) == 2 else 1
             elements = _entries(A, m, n, "A")
@@ -387,7 +412,7 @@ class ResidualFlexibility:
             columns = array.reshape(n, -1) if array.size and array.shape[0] == n else None
             if columns is None:
                 raise ProblemError(f"loads must have one row per degree of freedom ({n}), got shape {array.shape}")
-            load_entries = [{i: _rational(value) for i, value in enumerate(columns[:, c]) if value != 0}
+            load_entries = [{i: _rational(value, f"loads[{i}]") for i, value in enumerate(columns[:, c]) if value != 0}
                             for c in range(columns.shape[1])]
         return _reduce(self, n, m, mass, stiffness, elements, forces, gaps, laws, load_entries)
 
@@ -409,7 +434,7 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
             gaps: list, laws: Any, loads: list) -> ReducedStructure:
     import scipy.sparse
 
-    from .structures import sparse_modes
+    from .structures import _check_positive_definite, sparse_modes
 
     gmpy2 = _gmpy2()
     K = method.modes
@@ -420,7 +445,9 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
         return scipy.sparse.csc_matrix(([float(entries[k]) for k in keys], ([k[0] for k in keys], [k[1] for k in keys])),
                                        shape=(n, n))
 
-    float_modes = sparse_modes(as_float(mass), as_float(stiffness), columns)
+    float_mass = as_float(mass)
+    _check_positive_definite(float_mass, "M", "the structure")
+    float_modes = sparse_modes(float_mass, as_float(stiffness), columns)
     theta = float_modes.frequencies**2
     stiffest = max(float(abs(v)) for (i, j), v in stiffness.items() if i == j)
     lightest = min(float(v) for (i, j), v in mass.items() if i == j)
@@ -474,14 +501,14 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
             W = np.zeros((n, m), dtype=object) + gmpy2.mpfr(0)
             if forces is None:
                 for (i, j), value in elements.items():
-                    W[j, i] = gmpy2.mpfr(value)
+                    W[j, i] = _mpfr(value)
             else:
                 for (i, j), value in forces.items():
-                    W[i, j] = gmpy2.mpfr(value)
+                    W[i, j] = _mpfr(value)
             P = np.zeros((n, len(loads)), dtype=object) + gmpy2.mpfr(0)
             for column, load in enumerate(loads):
                 for i, value in load.items():
-                    P[i, column] = gmpy2.mpfr(value)
+                    P[i, column] = _mpfr(value)
             statics = np.hstack((W, P))
             Z = factor.solve(statics)  # K Z = [W, P]
             solves += statics.shape[1]
@@ -501,7 +528,7 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
             reduced_stiffness = V.T.dot(KV)
             A = np.zeros((m, n), dtype=object) + gmpy2.mpfr(0)
             for (i, j), value in elements.items():
-                A[i, j] = gmpy2.mpfr(value)
+                A[i, j] = _mpfr(value)
             reduced_A = A.dot(V)
             reduced_W = V.T.dot(W)
             reduced_loads = V.T.dot(P)
