@@ -149,6 +149,10 @@ def build_parser() -> argparse.ArgumentParser:
     nnm.add_argument("--order", type=int, default=2, help="expansion order (default 2)")
     nnm.add_argument("--precision", type=int, default=30, help="decimal digits of the arithmetic (default 30)")
     nnm.add_argument("--format", choices=FORMATS, default="pretty", help=FORMAT_HELP + " (--numeric: pretty, plain and latex print its summary)")
+    nnm.add_argument("--reduce", type=int, default=None, metavar="K",
+                     help="reduce the model first to its K lowest modes plus one residual-flexibility vector per element "
+                          "(ResidualFlexibility); required for a model whose M, K come from matrix files "
+                          "({\"matrices\": \"model.npz\" or {\"M\": file, \"K\": file}, \"elements\": [...]})")
     add_size_options(nnm)
 
     add_forced_parser(commands, FORMATS, FORMAT_HELP)
@@ -376,7 +380,6 @@ def _warned(compute: Any) -> Any:
 def _command_nnm(arguments: argparse.Namespace) -> str | tuple[str, int]:
     import json
 
-    from ..methods.strained_coordinates import nnm
     from ..problems.system import UnilateralSystem
     from ._files import check_system_size, read_json_file
 
@@ -384,8 +387,41 @@ def _command_nnm(arguments: argparse.Namespace) -> str | tuple[str, int]:
     data = read_json_file(arguments.system, "system file", **limits)
     if not isinstance(data, dict):
         raise ProblemError(f"the system file {arguments.system!r} must hold a JSON object with keys M, K, A, b (and optional W)")
-    check_system_size(data, "system file", **limits)
-    system = UnilateralSystem.from_json_dict(data)
+    reduction = None
+    if arguments.reduce is not None or "matrices" in data:
+        from ._structures import reduced_structure
+
+        if arguments.reduce is None:
+            raise ProblemError("a model whose matrices come from files is reduced first: give --reduce K (the modes kept, "
+                               "e.g. --reduce 8)")
+        if "matrices" not in data:
+            check_system_size(data, "system file", **limits)
+        reduction = reduced_structure(data, arguments.system, arguments.reduce, arguments.precision)
+        system = reduction.system
+    else:
+        check_system_size(data, "system file", **limits)
+        system = UnilateralSystem.from_json_dict(data)
+    output = _nnm_output(system, arguments)
+    if reduction is None:
+        return output
+    text, status = output if isinstance(output, tuple) else (output, 0)
+    line = (f"reduced: {reduction.n_dof} dof → {system.n_dof} ({reduction.modes} modes + residual vectors; "
+            f"{reduction.message})")
+    if arguments.format == "json":
+        content = json.loads(text)
+        content["reduction"] = {"n_dof": reduction.n_dof, "modes": reduction.modes, "reduced_dof": system.n_dof,
+                                "message": reduction.message}
+        text = json.dumps(content, indent=2, allow_nan=False)
+    else:
+        text = ("% " if arguments.format == "latex" else "") + line + "\n" + text
+    return text, status
+
+
+def _nnm_output(system: Any, arguments: argparse.Namespace) -> str | tuple[str, int]:
+    import json
+
+    from ..methods.strained_coordinates import nnm
+
     if arguments.numeric:
         return _numeric_nnm(system, arguments)
     if arguments.energy is not None:
