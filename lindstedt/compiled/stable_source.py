@@ -9,6 +9,7 @@ float evaluator of :class:`~lindstedt.Expansion` at a new κ).
 from __future__ import annotations
 
 import functools
+import math
 import textwrap
 from typing import Any, Callable
 
@@ -16,12 +17,13 @@ import numpy as np
 import sympy
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.numpy import NumPyPrinter
+from sympy.printing.pycode import PythonCodePrinter
 
 from .._precision import locked
 from .names import _PYTHON_RESERVED, _safe_names
 from .stable_series import Patch, StableCoefficient, stable_coefficient
 
-__all__ = ["renamed", "stable_c_source", "stable_coefficient_cached", "stable_function", "stable_numpy_source"]
+__all__ = ["renamed", "stable_c_source", "stable_coefficient_cached", "stable_function", "stable_numpy_source", "stable_scalar_source"]
 
 
 def renamed(stable: StableCoefficient, old: sympy.Symbol, new: sympy.Symbol) -> StableCoefficient:
@@ -131,11 +133,27 @@ def stable_c_source(name: str, x: sympy.Symbol, pieces: list, frequency: bool, a
     return "\n".join(lines) + "\n"
 
 
+def stable_scalar_source(name: str, x: sympy.Symbol, stable: StableCoefficient) -> str:
+    """The same patches as :func:`stable_numpy_source` for one float in plain Python (``math``; NaN outside)."""
+    printer = PythonCodePrinter({"fully_qualified_modules": True})
+    lines = [f"def {name}({x}):", "    try:"]
+    for index, patch in enumerate(stable.patches):
+        condition = _conditions(str(x), patch, "numpy").replace(" & ", " and ")
+        lines.append(f"        {'if' if index == 0 else 'elif'} {condition}:  # {patch.comment}")
+        local = sympy.Symbol("_x", real=True)
+        for symbol, value in patch.definitions:
+            lines.append(f"            {symbol} = {printer.doprint(value.xreplace({x: local}))}")
+        lines.append(f"            return {printer.doprint(patch.value)}")
+    lines += ["    except (ValueError, ZeroDivisionError, OverflowError):", "        pass", "    return math.nan"]
+    return "\n".join(lines).replace("_x", str(x)) + "\n"
+
+
 def stable_function(expression: sympy.Expr, symbol: sympy.Symbol) -> Callable[[Any], np.ndarray] | None:
     """A vectorised NumPy function of ``symbol`` evaluating ``expression`` (a gap coefficient ω_k(κ)) by the piecewise
     exact series of :mod:`lindstedt.compiled.stable_series` (relative error <= 1e-13 on (-1, 1), NaN outside), or None if
     the expression has another shape.  The same code as ``generate_code(expansion, "omega<k>")`` prints; the
-    series are generated once per expression (cached, 0.1-0.5 s).
+    series are generated once per expression (cached, 0.1-0.5 s).  The function has the attribute ``scalar``: the
+    same patches for one float in plain Python (measured 2-4 µs a call against 60 µs for the NumPy form on a 0-d array).
 
     Examples
     --------
@@ -151,9 +169,13 @@ def stable_function(expression: sympy.Expr, symbol: sympy.Symbol) -> Callable[[A
     renaming = _safe_names([symbol], _PYTHON_RESERVED)
     name = renaming[symbol]
     source = stable_numpy_source("lindstedt_stable", name, [(0, renamed(stable, symbol, name))], False, stable.summary)
-    namespace: dict[str, Any] = {"numpy": np}
+    namespace: dict[str, Any] = {"numpy": np, "math": math}
     exec(compile(source, "<lindstedt stable series>", "exec"), namespace)  # noqa: S102 - our own generated source
-    return namespace["lindstedt_stable"]
+    exec(compile(stable_scalar_source("lindstedt_stable_scalar", name, renamed(stable, symbol, name)),  # noqa: S102
+                 "<lindstedt stable series, scalar>", "exec"), namespace)
+    function = namespace["lindstedt_stable"]
+    function.scalar = namespace["lindstedt_stable_scalar"]
+    return function
 
 
 @locked  # around the cache: threads asking at once for one coefficient derive it once

@@ -3,8 +3,13 @@
 With free symbols the closed forms are compiled once into a float64 family with a first-order rounding-error bound
 (:func:`lindstedt.compiled.family.compile_family`); a value is used where its bound is below 1e-13 (relative for
 ω_k and φ_k, of |a0| for u), else repaired: by the exact series of a gap coefficient in acos κ
-(:func:`lindstedt.compiled.stable_source.stable_function`, generated once a few points needed it) or by the exact
-expression at the double's exact value.  Without free symbols the floats are computed once.  Exact numbers a
+(:func:`lindstedt.compiled.stable_source.stable_function`) or by the exact expression at the double's exact value.
+With one free symbol the closed form of each ω_k is probed once on the nodes of
+:func:`lindstedt.results._values.parameter_grid` when ω_k is first asked for: if it fails the bound at a node, its
+stable series is generated then (0.1-0.3 s per coefficient, once), so that later parameter values new to the
+expansion cost microseconds, not the 5-20 ms of an exact evaluation or a generation on demand (measured before:
+worst 0.30 s for ``frequency_coefficients`` at a new κ, order 4).  Other coefficients get their series after
+_STABLE_AFTER exact repairs, as before.  Without free symbols the floats are computed once.  Exact numbers a
 double cannot hold are evaluated through the exactly substituted coefficients (:func:`frequency_coefficients`,
 :func:`float_branches`, :func:`phase_value`).
 
@@ -20,7 +25,7 @@ import numpy as np
 
 from ..compiled.stable_source import stable_function
 from ..engine.float_branches import FloatBranches
-from ._values import Point, finite, floats, omega_expr, substitution, to_float
+from ._values import Point, finite, floats, omega_expr, probe_points, substitution, to_float
 from ._waveform_data import _WAVEFORM_TOLERANCE, _WaveformData, _WaveformLayout
 
 __all__ = ["COEFFICIENT_TOLERANCE", "WARNING_TOLERANCE", "float_branches", "frequency_coefficients", "omega_values",
@@ -46,6 +51,8 @@ def omega_values(expansion: Any, highest: int, point: Point, tolerance: float = 
                 constants[k] = to_float(omega_expr(expansion, k))
         rows = np.array([constants[k] for k in range(highest + 1)])
     else:
+        if len(state.symbols) == 1 and state.cache.get(("probed", tolerance), -1) < highest:
+            _probe(expansion, highest, tolerance)
         core = cache.get("core")
         done = -1
         parts = []
@@ -90,16 +97,42 @@ def _repair(expansion: Any, values: np.ndarray, bad: np.ndarray, k: int, point: 
     if not bad.any():
         return
     state = expansion._floats
-    counts = state.cache.setdefault("repairs", {})
-    counts[k] = counts.get(k, 0) + int(bad.sum())
-    stable = _stable_omega(expansion, k) if counts[k] >= _STABLE_AFTER else None
+    stables = state.cache.setdefault("stable", {})
+    if k in stables:
+        stable = stables[k]
+    else:  # not flagged by the probe: the series after a few exact repairs
+        counts = state.cache.setdefault("repairs", {})
+        counts[k] = counts.get(k, 0) + int(bad.sum())
+        stable = _stable_omega(expansion, k) if counts[k] >= _STABLE_AFTER else None
     if stable is not None:
-        fixed = np.broadcast_to(np.asarray(stable(*point.arrays), dtype=float), point.shape).reshape(-1)
+        if not point.shape:
+            fixed = np.array([stable.scalar(float(point.arrays[0]))])
+        else:
+            fixed = np.broadcast_to(np.asarray(stable(*point.arrays), dtype=float), point.shape).reshape(-1)
         usable = bad & np.isfinite(fixed)
         values[usable] = fixed[usable]
         bad = bad & ~usable
     for index in np.flatnonzero(bad):
         values[index] = state.exact_at(omega_expr(expansion, k), point, int(index))
+
+
+def _probe(expansion: Any, highest: int, tolerance: float) -> None:
+    """Generate the stable series of each ω_k (k ≤ highest, one free symbol) whose compiled closed form fails the
+    rounding bound ``tolerance`` at a point of :func:`~lindstedt.results._values.probe_points` or changes sign
+    between two of them (near a root no closed form is accurate relative to ω_k): see the module docstring."""
+    state = expansion._floats
+    key = ("probed", tolerance)
+    points = np.sort(probe_points(expansion))
+    if points.size:
+        for k in range(state.cache.get(key, -1) + 1, highest + 1):
+            family = state.family(("omega", k), lambda k=k: [omega_expr(expansion, k)])
+            if family is None:
+                continue
+            values, bounds = family(points)
+            signs = np.sign(values[0])
+            if not np.all(bounds <= tolerance * np.abs(values)) or np.any(signs[1:] * signs[:-1] < 0):
+                _stable_omega(expansion, k)
+    state.cache[key] = highest
 
 
 def _stable_omega(expansion: Any, k: int) -> Callable[[Any], np.ndarray] | None:

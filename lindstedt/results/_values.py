@@ -27,9 +27,11 @@ from .._precision import locked
 from ..problems.parsing import parse_real
 from .assumptions import check_names, shown_values
 
-__all__ = ["UNSET", "FloatState", "Point", "finite", "floats", "omega_expr", "omega_known", "read", "substitution", "to_float", "values_key"]
+__all__ = ["GRID_CELLS", "UNSET", "FloatState", "Point", "finite", "floats", "grid_cell", "omega_expr", "omega_known",
+           "parameter_grid", "probe_points", "read", "substitution", "to_float", "values_key"]
 
 _MEMORY = 64  # scalar parameter points whose float data an expansion keeps
+GRID_CELLS = 256  # cells of the parameter grid of a one-parameter expansion (:func:`parameter_grid`)
 UNSET: Any = object()  # a member of FloatState not built yet
 
 
@@ -254,6 +256,60 @@ def _core(expansion: Any) -> tuple[Any, int, int]:
         return [*conditions, *[omega_expr(expansion, k) for k in range(highest + 1)]]
 
     return expansion._floats.family(("core", highest), expressions), len(conditions), highest
+
+
+def parameter_grid(expansion: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    """For an expansion with one free symbol p: the grid nodes p_i = s_i / (1 − |s_i|), s_i = −1 + 2i/GRID_CELLS
+    (i = 0 … GRID_CELLS; ±inf at the ends: uniform in s = p / (1 + |p|), which maps the real line onto (−1, 1)),
+    and whether the derivation's assumptions hold at each node (decided by the float test, not undecided);
+    None for other expansions.  What the evaluators tabulate once per expansion (the range of ε that needs no
+    warning, the coefficients whose closed form cancels somewhere) is tabulated on these nodes."""
+    state = expansion._floats
+    if "grid" not in state.cache:
+        grid = None
+        if len(state.symbols) == 1:
+            s = np.linspace(-1.0, 1.0, GRID_CELLS + 1)
+            with np.errstate(divide="ignore"):
+                nodes = s / (1 - np.abs(s))
+            valid = np.isfinite(nodes)
+            family, conditions, _ = _core(expansion)
+            if family is None and conditions:
+                valid[:] = False
+            elif conditions:
+                values, bounds = family(nodes[valid])
+                violated, undecided = expansion._assumptions.float_verdict(values[:conditions], bounds[:conditions], (nodes[valid],))
+                valid[valid] = ~violated & ~undecided
+            grid = (nodes, valid)
+        state.cache["grid"] = grid
+    return state.cache["grid"]
+
+
+def probe_points(expansion: Any) -> np.ndarray:
+    """The valid nodes of :func:`parameter_grid` and, towards each end of a valid stretch, 52 points approaching the
+    neighbouring invalid node geometrically (to within 2^-52 of the way; doubling up to 2^40 towards ±inf): where a
+    closed form that cancels at the edge of its domain (a gap κ → ±a0) fails first.  Empty without a grid."""
+    grid = parameter_grid(expansion)
+    if grid is None:
+        return np.array([])
+    nodes, valid = grid
+    parts = [nodes[valid]]
+    steps = 1 - 0.5 ** np.arange(1, 53)
+    for index in np.flatnonzero(valid):
+        for neighbour in (index - 1, index + 1):
+            if 0 <= neighbour < len(nodes) and not valid[neighbour]:
+                if np.isfinite(nodes[neighbour]):
+                    parts.append(nodes[index] + (nodes[neighbour] - nodes[index]) * steps)
+                else:
+                    parts.append(nodes[index] * 2.0 ** np.arange(1, 41))
+    return np.concatenate(parts)
+
+
+def grid_cell(value: Any) -> Any:
+    """The index of the cell of :func:`parameter_grid` holding p (int, or int array for an array)."""
+    if isinstance(value, float):
+        return min(max(int((value / (1 + abs(value)) + 1) * (GRID_CELLS / 2)), 0), GRID_CELLS - 1)
+    value = np.asarray(value, dtype=float)
+    return np.clip(((value / (1 + np.abs(value)) + 1) * (GRID_CELLS / 2)).astype(np.int64), 0, GRID_CELLS - 1)
 
 
 def omega_expr(expansion: Any, k: int) -> sympy.Expr:
