@@ -297,8 +297,10 @@ def _range_at(expansion: Any, arguments: tuple[float, ...], source: Any = UNSET)
 #     |ε| < _QUIET_MARGIN (min(q_j, q_{j+1}) − max(|Δ²q_j|, |Δ²q_{j+1}|)),   Δ²q_j = q_{j−1} − 2 q_j + q_{j+1},
 # without an OrbitRange: for a smooth q the linear interpolant errs by about |Δ²q|/8 inside the cell, and a kink or
 # a jump (two events crossing, a regime change) makes Δ²q as large as the jump, so the bound drops to nothing
-# there.  A sampled bound, not a proven one (checked on 20 000 p against the exact OrbitRange for the laws of
-# tests/test_evaluators_quiet.py: no miss); every other ε or p takes the exact OrbitRange as before.
+# there.  A sampled bound, not a proven one: checked against the exact OrbitRange at 20 000 random κ for
+# Max(0, u - kappa) and 3 000-5 000 p for alpha*u**3, kappa*Max(0, u - 1/2), u**3 + kappa*u**2 (no p where the
+# table accepted an ε the OrbitRange would warn about; tests/test_evaluators_quiet.py checks 300 κ on every run).
+# Every other ε or p takes the exact OrbitRange as before.
 def _quiet_table(expansion: Any) -> np.ndarray | None:
     """Per cell of :func:`parameter_grid`: the |ε| below which the expansion needs no warning (0: none known)."""
     cache = expansion._floats.cache
