@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Iterable, Mapping
 
+import gmpy2
 import numpy as np
 import sympy
 from sympy import Rational
@@ -164,7 +165,7 @@ class CosineSeries(_TrigonometricSeries):
     True
     """
 
-    __slots__ = ("_integer_form",)  # cached by _rational_product: (integer numerators, common denominator)
+    __slots__ = ("_integer_form",)  # the _IntegerForm of a rational series, cached by its first product
     _basis = staticmethod(sympy.cos)
     _numpy_basis = staticmethod(np.cos)
 
@@ -194,7 +195,7 @@ class CosineSeries(_TrigonometricSeries):
                 return self._rational_product(other)
         elif shorter >= _DENSE_FLOAT_TERMS:
             return self._fixed_point_product(other)
-        half = self.domain.convert(Rational(1, 2))
+        half = _half(self.domain)
         accumulated: dict[int, DomainElement] = {}
         zero = self.domain.zero
         for m, a in self._coefficients.items():
@@ -232,6 +233,7 @@ class CosineSeries(_TrigonometricSeries):
             return {harmonic: mantissa << (exponent - lowest) for harmonic, (mantissa, exponent) in parts.items()}, lowest
 
         (first, first_exponent), (second, second_exponent) = integers(self), integers(other)
+        first, second = _IntegerForm(first), _IntegerForm(second)
         exponent = first_exponent + second_exponent - 1  # the 1/2 of the product-to-sum rule
         dtype = self.domain.dtype
         with workprec(self.domain.precision):  # the one rounding, to the domain's precision
@@ -256,7 +258,7 @@ class CosineSeries(_TrigonometricSeries):
                 weight = (1 if m + n == harmonic else 0) + (1 if abs(m - n) == harmonic else 0)
                 if weight:
                     total = total + a * b * weight
-        return total * self.domain.convert(Rational(1, 2))
+        return total * _half(self.domain)
 
     def __pow__(self, exponent: int) -> "CosineSeries":
         if not isinstance(exponent, int) or exponent < 0:
@@ -362,8 +364,10 @@ def solve_harmonic_oscillator(
         )
     inverse_alpha0 = domain.one / alpha0 if alpha0 != domain.one else domain.one
     particular: dict[int, DomainElement] = {}
+    # 1/(1 − n²) as a gmpy rational over QQ (sympy's convert of a Rational: 13 % of Duffing order 100)
+    divisor = (lambda n: domain.dtype(1, 1 - n * n)) if domain.is_QQ else (lambda n: domain.convert(Rational(1, 1 - n * n)))
     for harmonic, value in right_hand_side._coefficients.items():
-        particular[harmonic] = value * inverse_alpha0 * domain.convert(Rational(1, 1 - harmonic * harmonic))
+        particular[harmonic] = value * inverse_alpha0 * divisor(harmonic)
     if first_harmonic is not None:
         particular[1] = first_harmonic
     else:
@@ -372,6 +376,12 @@ def solve_harmonic_oscillator(
             total = total + value
         particular[1] = value_at_zero - total
     return CosineSeries(domain, particular)
+
+
+def _half(domain: Any) -> DomainElement:
+    """½ in ``domain``; over ``QQ`` a gmpy rational directly (sympy's convert of a Rational cost a third of
+    Duffing at order 10)."""
+    return domain.dtype(1, 2) if domain.is_QQ else domain.convert(Rational(1, 2))
 
 
 def power_by_squaring(base: Any, exponent: int, one: Any) -> Any:
@@ -396,122 +406,192 @@ def sum_series(terms: Iterable[CosineSeries], domain: Any) -> CosineSeries:
     return CosineSeries(domain, accumulated)
 
 
-def _pack(values: list[int], width: int) -> int:
-    """``Σ_i values[i] 2^(8·width·i)`` for signed integers, from two unsigned byte strings (linear time)."""
-    from sympy.external.gmpy import MPZ
+def _pack(values: list[int], bits: int) -> Any:
+    """``Σ_i values[i] 2^(bits·i)`` for signed integers: two ``gmpy2.pack`` of the positive and negative parts.
 
-    zero = bytes(width)
-    positive = b"".join(v.to_bytes(width, "little") if v > 0 else zero for v in values)
-    negative = b"".join((-v).to_bytes(width, "little") if v < 0 else zero for v in values)
-    return MPZ(int.from_bytes(positive, "little")) - MPZ(int.from_bytes(negative, "little"))
-
-
-def _unpack(total: int, count: int, width: int) -> list[int]:
-    """The ``count`` signed digits (8·width bits each) of ``total = Σ_i d_i 2^(8·width·i)``."""
-    raw = int(total).to_bytes((count + 1) * width, "little", signed=True)
-    full, half = 1 << (8 * width), 1 << (8 * width - 1)
-    result, borrow = [], 0
-    for index in range(count):
-        digit = int.from_bytes(raw[index * width:(index + 1) * width], "little") + borrow
-        borrow = digit >= half
-        result.append(digit - full if borrow else digit)
-    return result
+    Measured at Duffing order 100: ``int.to_bytes`` and ``bytes.join`` (the packing before gmpy2.pack)
+    took 34 % of the run.
+    """
+    return gmpy2.pack([v if v > 0 else 0 for v in values], bits) - gmpy2.pack([-v if v < 0 else 0 for v in values], bits)
 
 
-def _rational_integer_form(series: CosineSeries) -> tuple[dict[int, int], int]:
-    """``({n: L c_n}, L)`` with L the lcm of the denominators, cached on the series (a waveform enters many products)."""
+def _unpack(total: Any, count: int, bits: int) -> list[Any]:
+    """The ``count`` signed digits ``d_i`` (|d_i| < 2^(bits−1)) of ``total = Σ_i d_i 2^(bits·i)``.
+
+    Every digit is lifted by 2^(bits−1) (one packed constant), which makes them the unsigned digits
+    ``gmpy2.unpack`` reads; each lifted digit is nonzero, so exactly ``count`` come back.
+    """
+    half = 1 << (bits - 1)
+    return [digit - half for digit in gmpy2.unpack(total + gmpy2.pack([half] * count, bits), bits)]
+
+
+def _digit_bits(bits: int) -> int:
+    """``bits`` rounded up to one of eight widths per octave (a packed form then serves many sums, ≤ 12.5 % wider)."""
+    step = 1 << max(bits.bit_length() - 4, 3)
+    return -(-bits // step) * step
+
+
+class _IntegerForm:
+    """A rational series as integers over one denominator, with its packed forms (cached on the series).
+
+    ``values[i]`` is ``L c_n`` for ``n = stride·i + offset``; ``stride`` is 2 when every harmonic has
+    one parity (Duffing's odd waveforms and even powers), which halves the packed integers.  A
+    waveform enters ~2N products and N linear combinations up to order N: it is packed once per
+    digit width (:func:`_digit_bits`) and direction, not once per product.
+    """
+
+    __slots__ = ("denominator", "bits", "stride", "offset", "values", "_packed")
+
+    def __init__(self, coefficients: Mapping[int, Any]):
+        common = 1
+        for value in coefficients.values():
+            common = gmpy2.lcm(common, value.denominator)
+        parities = {n & 1 for n in coefficients}
+        self.stride, self.offset = (2, parities.pop()) if len(parities) == 1 else (1, 0)
+        self.denominator = common
+        self.values = self._dense(coefficients, self.stride, self.offset)
+        self.bits = max(abs(v) for v in self.values).bit_length()
+        self._packed: dict[tuple[int, int, bool], Any] = {}
+
+    def _dense(self, coefficients: Mapping[int, Any], stride: int, offset: int) -> list[Any]:
+        values = [0] * ((max(coefficients) - offset) // stride + 1)
+        common = self.denominator
+        for n, value in coefficients.items():
+            values[(n - offset) // stride] = value.numerator * (common // value.denominator)
+        return values
+
+    def packed_length(self, stride: int) -> int:
+        """Entries of the dense vector at ``stride``."""
+        return len(self.values) if stride == self.stride else self.offset + 2 * len(self.values) - 1
+
+    def packed(self, bits: int, stride: int, reverse: bool = False) -> tuple[Any, int]:
+        """(packed integer, length) of the values at ``stride`` (1 unpacks a stride-2 form), reversed if asked."""
+        key = (bits, stride, reverse)
+        if key not in self._packed:
+            values = self.values
+            if stride != self.stride:  # stride 1 from stride 2: interleave zeros
+                values = [0] * (self.offset + 2 * len(self.values) - 1)
+                values[self.offset::2] = self.values
+            self._packed[key] = (_pack(values[::-1] if reverse else values, bits), len(values))
+        return self._packed[key]
+
+
+def _integer_form(series: CosineSeries) -> _IntegerForm:
     try:
         return series._integer_form
     except AttributeError:
-        from sympy.external.gmpy import lcm
-
-        common = 1
-        for value in series._coefficients.values():
-            common = lcm(common, value.denominator)
-        # Python ints (not mpz): packing converts them to bytes many times
-        form = {n: int(value.numerator * (common // value.denominator)) for n, value in series._coefficients.items()}, common
-        series._integer_form = form
-        return form
+        series._integer_form = _IntegerForm(series._coefficients)
+        return series._integer_form
 
 
 def sum_of_products(pairs: Iterable[tuple[CosineSeries, CosineSeries]], domain: Any) -> CosineSeries:
     """``Σ_j a_j b_j`` for cosine series ``(a_j, b_j)``: one exact integer computation for rational series.
 
-    Over ``QQ`` every series is put over the lcm of its denominators, the products of a sum are
-    scaled to one common denominator, packed (Kronecker substitution, :func:`_doubled_product_sum`) and
-    added as integers, and the digits are read back and reduced once per sum — not once per
-    product.  Measured on Duffing, ω and waveforms to order 100 (sums of ~2n products per order):
-    6.3 s with the pairwise loop of gmpy rationals, see ``benchmarks/`` for the current figure.
-    Other domains (and short rational series, where the loop is faster) sum the products.
+    Over ``QQ`` every series is put over the lcm of its denominators (:class:`_IntegerForm`), the
+    products of a sum are scaled to one common denominator, multiplied as packed integers (Kronecker
+    substitution, :func:`_doubled_product_sum`) and added, and the digits are read back and reduced
+    once per sum — not once per product.  Other domains (and short rational series, where the loop
+    is faster) sum the products.
     """
     pairs = [(a, b) for a, b in pairs if a._coefficients and b._coefficients]
     if not domain.is_QQ or not pairs or max(min(len(a._coefficients), len(b._coefficients)) for a, b in pairs) < _DENSE_EXACT_TERMS:
         return sum_series((a * b for a, b in pairs), domain)
-    forms = [(_rational_integer_form(a), _rational_integer_form(b)) for a, b in pairs]
-    from sympy.external.gmpy import lcm
-
+    forms = [(_integer_form(a), _integer_form(b)) for a, b in pairs]
     denominator = 1
-    for (_, first), (_, second) in forms:
-        denominator = lcm(denominator, first * second)
-    doubled = _doubled_product_sum([(a, b, denominator // (first * second)) for (a, first), (b, second) in forms])
+    for first, second in forms:
+        denominator = gmpy2.lcm(denominator, first.denominator * second.denominator)
+    doubled = _doubled_product_sum([(a, b, denominator // (a.denominator * b.denominator)) for a, b in forms])
     dtype, twice = domain.dtype, 2 * denominator
     return CosineSeries(domain, {n: dtype(total, twice) for n, total in doubled.items()})
 
 
-def _dense(series: Mapping[int, int], stride: int, offset: int, length: int) -> list[int]:
-    values = [0] * length
-    for n, value in series.items():
-        values[(n - offset) // stride] = value
-    return values
+def linear_combination(factors: list[DomainElement], terms: list[CosineSeries], domain: Any) -> CosineSeries:
+    """``Σ_j factors[j] · terms[j]``; over ``QQ`` one packed integer sum read back once (the waveform's
+    ``Σ_i A_i w''_{k−i}``: at Duffing order 100 the series-by-series sum took a third of the run)."""
+    pairs = [(factor, term) for factor, term in zip(factors, terms) if factor and term._coefficients]
+    if not domain.is_QQ or len(pairs) < 2:
+        return sum_series((term.scale(factor) for factor, term in pairs), domain)
+    forms = [(factor, _integer_form(term)) for factor, term in pairs]
+    stride = 2 if len({(form.stride, form.offset) for _, form in forms}) == 1 and forms[0][1].stride == 2 else 1
+    offset = forms[0][1].offset if stride == 2 else 0
+    denominator = 1
+    for factor, form in forms:
+        denominator = gmpy2.lcm(denominator, factor.denominator * form.denominator)
+    scales = [factor.numerator * (denominator // (factor.denominator * form.denominator)) for factor, form in forms]
+    bound = max(scale.bit_length() + form.bits for scale, (_, form) in zip(scales, forms)) + len(forms).bit_length() + 1
+    bits = _digit_bits(bound)
+    total, length = 0, 0
+    for scale, (_, form) in zip(scales, forms):
+        packed, size = form.packed(bits, stride)
+        total += packed * scale
+        length = max(length, size)
+    dtype = domain.dtype
+    return CosineSeries(domain, {stride * index + offset: dtype(value, denominator)
+                                 for index, value in enumerate(_unpack(total, length, bits)) if value})
 
 
-def _layout(series: Mapping[int, int]) -> tuple[int, int]:
-    """(stride, offset): (2, parity) when every harmonic has one parity (Duffing's odd waveforms), else (1, 0)."""
-    parities = {n & 1 for n in series}
-    return (2, parities.pop()) if len(parities) == 1 else (1, 0)
-
-
-def _doubled_product_sum(terms: list[tuple[Mapping[int, int], Mapping[int, int], int]]) -> dict[int, int]:
+def _doubled_product_sum(terms: list[tuple[_IntegerForm, _IntegerForm, Any]]) -> dict[int, Any]:
     """``Σ_j scale_j · 2 (a_j · b_j)`` for integer cosine series: sums over m + n and |m − n| = k.
 
-    Kronecker substitution: each vector is packed into one integer (digits of 8·width bits, wide
-    enough for every signed sum), so a convolution is one multiplication — GMP's subquadratic
-    one with gmpy2 — and the correlation (|m − n|) is the convolution with the second vector
-    reversed.  Terms whose harmonics share a layout are added as packed integers and read back
-    once; a series of one parity is indexed by n // 2, which halves the packed integers.
-    Measured here, 200 × 200 entries of 3000 bits: 6.3 ms against 272 ms for the pairwise loop
-    on Python integers.
+    Kronecker substitution: each vector is packed into one integer (digits wide enough for every
+    signed sum), so a convolution is one multiplication — GMP's subquadratic one — and the
+    correlation (|m − n|) is the convolution with the second vector reversed.  Terms whose
+    harmonics share a layout are added as packed integers and read back once; the packed forms
+    are cached on the series (:class:`_IntegerForm`): at Duffing order 100 (7,100 products) the
+    operands are packed ~5,000 times instead of 21,300.  What is left there is GMP's
+    multiplications, ~0.15 s of the 0.3 s (products of ~n/2 entries of ~5n bits, ~1.5n per order n).
+
+    Tried and measured slower at orders ≤ 100 (``MAX_ORDER``): relaxed multiplication in the
+    order index (pairs (i, j) tiled by squares computed once each, van der Hoeven's tiling cut at
+    the requested order): as one bivariate Kronecker product per square, 0.52 s against 0.30 s at
+    order 100 (the order slots double both operands); by Karatsuba on the packed series, 0.32 s
+    (the squares' multiplications halve, their common denominators and read-backs eat the gain).
     """
-    groups: dict[tuple[int, int, int], list[tuple[Mapping[int, int], Mapping[int, int], int]]] = {}
+    groups: dict[tuple[int, int, int], list[tuple[_IntegerForm, _IntegerForm, Any]]] = {}
     for a, b, scale in terms:
-        (a_stride, a_offset), (b_stride, b_offset) = _layout(a), _layout(b)
-        if a_stride != b_stride:
-            a_stride = b_stride = 1
-            a_offset = b_offset = 0
-        groups.setdefault((a_stride, a_offset, b_offset), []).append((a, b, scale))
-    result: dict[int, int] = {}
+        stride = 2 if a.stride == b.stride == 2 else 1
+        groups.setdefault((stride, a.offset if stride == 2 else 0, b.offset if stride == 2 else 0), []).append((a, b, scale))
+    result: dict[int, Any] = {}
     for (stride, a_offset, b_offset), members in groups.items():
-        a_length = max((max(a) - a_offset) // stride + 1 for a, _, _ in members)
-        b_length = max((max(b) - b_offset) // stride + 1 for _, b, _ in members)
-        bound = max(
-            max(abs(v) for v in a.values()).bit_length() + max(abs(v) for v in b.values()).bit_length() + scale.bit_length()
-            for a, b, scale in members
-        )
-        width = (bound + min(a_length, b_length).bit_length() + len(members).bit_length() + 2 + 7) // 8
+        a_length = max(a.packed_length(stride) for a, _, _ in members)
+        b_length = max(b.packed_length(stride) for _, b, _ in members)
+        bound = max(a.bits + b.bits + scale.bit_length() for a, b, scale in members)
+        bits = _digit_bits(bound + min(a_length, b_length).bit_length() + len(members).bit_length() + 1)
         sums = correlation = 0
         for a, b, scale in members:
-            packed_a = _pack(_dense(a, stride, a_offset, a_length), width)
-            b_values = _dense(b, stride, b_offset, b_length)
-            sums += packed_a * _pack(b_values, width) * scale
-            correlation += packed_a * _pack(b_values[::-1], width) * scale
-        count = a_length + b_length - 1
-        for index, value in enumerate(_unpack(sums, count, width)):
-            if value:
-                harmonic = stride * index + a_offset + b_offset
-                result[harmonic] = result.get(harmonic, 0) + value
-        last = b_length - 1  # correlation entry index <-> i − j = index − last
-        for index, value in enumerate(_unpack(correlation, count, width)):
-            if value:
-                harmonic = abs(stride * (index - last) + a_offset - b_offset)
-                result[harmonic] = result.get(harmonic, 0) + value
+            packed_a, _ = a.packed(bits, stride)
+            packed_b, _ = b.packed(bits, stride)
+            reversed_b, length = b.packed(bits, stride, reverse=True)
+            term, mirrored = packed_a * packed_b, packed_a * reversed_b
+            if scale != 1:
+                term, mirrored = term * scale, mirrored * scale
+            sums += term
+            # b reversed at its own length, aligned to the group's longest b
+            correlation += mirrored << (bits * (b_length - length)) if length != b_length else mirrored
+        _fold(sums, correlation, a_length, b_length, bits, stride, a_offset, b_offset, result)
     return {n: value for n, value in result.items() if value}
+
+
+def _fold(sums: Any, correlation: Any, a_length: int, b_length: int, bits: int, stride: int, a_offset: int, b_offset: int,
+          result: dict[int, Any]) -> None:
+    """Add the digits of a packed convolution and correlation to ``result`` (harmonic: doubled product).
+
+    Sum digit i is harmonic stride·i + a_offset + b_offset; correlation digit i is |stride·i + shift|
+    (b reversed at ``b_length``), its negative part folding back.  Dense lists, no dictionary per digit.
+    """
+    count = a_length + b_length - 1
+    dense = [0] * (stride * (count - 1) + a_offset + b_offset + 1)
+    dense[a_offset + b_offset::stride] = _unpack(sums, count, bits)
+    mirrored = _unpack(correlation, count, bits)
+    shift = a_offset - b_offset - stride * (b_length - 1)
+    first = -(shift // stride)  # first digit with stride·i + shift >= 0
+    positive, negative = mirrored[first:], mirrored[:first][::-1]
+    start = stride * first + shift
+    dense[start:start + stride * len(positive):stride] = [x + y for x, y in zip(dense[start::stride], positive)]
+    if negative:  # harmonics −(stride·i + shift) for i = first − 1, first − 2, …
+        start = -(stride * (first - 1) + shift)
+        dense[start:start + stride * len(negative):stride] = [x + y for x, y in zip(dense[start::stride], negative)]
+    for harmonic, value in enumerate(dense):
+        if value:
+            result[harmonic] = result.get(harmonic, 0) + value
+

@@ -55,7 +55,7 @@ import numpy
 import sympy
 from sympy import QQ, RealField
 
-from ..algebra.cosine import CosineSeries, solve_harmonic_oscillator, sum_of_products, sum_series
+from ..algebra.cosine import CosineSeries, linear_combination, solve_harmonic_oscillator, sum_of_products, sum_series
 from .._errors import UnsupportedNonlinearityError
 from ..problems.oscillator import DISPLACEMENT, Oscillator
 from .float_branches import FloatBranches
@@ -567,6 +567,7 @@ class SmoothHierarchy(LazyOrders):
         domain = form.domain
         self._domain = domain
         self._waveforms: list[CosineSeries] = [CosineSeries.cosine(domain)]
+        self._curvatures: list[CosineSeries] = [self._waveforms[0].second_derivative()]  # w_k''
         self._squared: list[Any] = [domain.one]
         self._frequencies: list[Any] = [domain.one]
         self._delta_powers: dict[tuple[int, int], CosineSeries] = {}
@@ -660,9 +661,9 @@ class SmoothHierarchy(LazyOrders):
         while len(self._waveforms) <= order:
             k = len(self._waveforms)
             self.squared_frequency(k)
-            right_hand_side = -self.forcing(k - 1)
-            for i in range(1, k + 1):
-                right_hand_side = right_hand_side - self._waveforms[k - i].second_derivative().scale(self._squared[i])
+            # −F_{k−1} − Σ_i A_i w''_{k−i}: the w'' cached, the sum one exact integer sum over QQ
+            curvature = linear_combination(self._squared[1:k + 1], self._curvatures[::-1], self._domain)
+            right_hand_side = -self.forcing(k - 1) - curvature
             # The secular coefficient vanishes by the choice of A_k: exactly in exact domains
             # (solve_harmonic_oscillator checks it), to rounding in float domains (removed here).
             if self.form.prune_tolerance is not None:
@@ -673,4 +674,5 @@ class SmoothHierarchy(LazyOrders):
             else:
                 solution = solve_harmonic_oscillator(right_hand_side, self._domain.one, first_harmonic=self._domain.zero)
             self._waveforms.append(self._prune(solution))
+            self._curvatures.append(self._waveforms[-1].second_derivative())
         return self._waveforms[order]
