@@ -130,7 +130,10 @@ def _degree(f: sympy.Expr, variable: sympy.Symbol) -> int:
     """The polynomial degree of f in u, reading every switch as linear (``Max(0, u)**2`` has degree 2)."""
     linear = f.replace(lambda e: isinstance(e, _SWITCHES + (sympy.Piecewise,)), lambda e: variable)
     try:
-        return max(1, int(sympy.Poly(linear, variable).degree()))
+        degree = sympy.Poly(linear, variable).degree()
+        if degree.is_infinite if isinstance(degree, sympy.Basic) else False:  # the switches cancel: Max(0, u) - Max(0, -u)
+            raise ValueError
+        return max(1, int(degree))
     except (sympy.PolynomialError, sympy.GeneratorsNeeded, ValueError):
         powers = [int(p.exp) for p in f.atoms(sympy.Pow) if p.base.has(variable) and p.exp.is_Integer and p.exp > 0]
         return max([1, *powers])

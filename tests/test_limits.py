@@ -9,6 +9,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
+import sympy
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -242,3 +243,14 @@ def test_a_forced_orbit_is_priced_from_the_periods_its_maps_span():
             lindstedt.forced_periodic_orbit(problem, 0.0015, epsilon=0.1)
     with limits.budget(seconds=60):
         assert lindstedt.forced_periodic_orbit(problem, 1.2, epsilon=0.1).success
+
+
+def test_a_law_whose_switches_cancel_when_linearised_is_priced_not_crashed():
+    # Max(0, u - κ) - Max(0, -u - κ) reads as u - u = 0 in the cost model's degree: it crashed with a TypeError
+    with pytest.raises(lindstedt.UnsupportedNonlinearityError, match="numeric gaps"):
+        lindstedt.expand("Max(0, u - kappa) - Max(0, -u - kappa)", order=2, params={"kappa": None})
+    exact = lindstedt.expand("Max(0, u - 1/3) - Max(0, -u - 1/3)", order=1, a0=1, omega0=1)
+    # dead band |u| < 1/3, unit slope outside, u₀ = cos s: ω₁ = (1/2π) ∫₀^{2π} f(cos s) cos s ds, and each side gives
+    # ∫_{|s|<β} (cos s − cos β) cos s ds = β − sin β cos β (cos β = 1/3), so ω₁ = (2β − sin 2β)/(2π)
+    beta = sympy.acos(sympy.Rational(1, 3))
+    assert sympy.simplify(exact.omega[1] - (2 * beta - sympy.sin(2 * beta)) / (2 * sympy.pi)) == 0
