@@ -19,21 +19,24 @@ module, never the other way round.
 
 from __future__ import annotations
 
+import math
+from collections import OrderedDict
 from typing import Any, Callable, Mapping
 
 import numpy as np
 
 from ..compiled.stable_source import stable_function
 from ..engine.float_branches import FloatBranches
-from ._values import Point, finite, floats, omega_expr, probe_points, substitution, to_float
+from ._values import Point, core_family, finite, floats, omega_expr, probe_points, substitution, to_float
 from ._waveform_data import _WAVEFORM_TOLERANCE, _WaveformData, _WaveformLayout
 
 __all__ = ["COEFFICIENT_TOLERANCE", "WARNING_TOLERANCE", "float_branches", "frequency_coefficients", "omega_values",
-           "phase_value", "phase_values", "waveform_data", "waveform_layout"]
+           "phase_value", "phase_values", "scalar_omegas", "waveform_data", "waveform_layout"]
 
 COEFFICIENT_TOLERANCE = 1e-13  # relative rounding bound accepted for a compiled ω_k, φ_k
 WARNING_TOLERANCE = 1e-3  # ... for ω_{N+1}, ω_{N+2} when only a warning reads them
 _STABLE_AFTER = 4  # exact evaluations of one ω_k before its stable series is generated (≈ 0.1-0.4 s)
+_SCALAR_MEMORY = 64  # one-parameter points whose plain-float ω_k an expansion keeps (:func:`scalar_omegas`)
 
 
 def omega_values(expansion: Any, highest: int, point: Point, tolerance: float = COEFFICIENT_TOLERANCE) -> np.ndarray:
@@ -71,6 +74,78 @@ def omega_values(expansion: Any, highest: int, point: Point, tolerance: float = 
         finite(rows, expansion.problem.numeric_substitution(state.values_at(point, index)) if point.arrays else {})
     cache[key] = rows
     return rows
+
+
+def scalar_omegas(expansion: Any, value: float, last: int, following: bool) -> list[float] | None:
+    """ω_0 … ω_last (and ω_{last+1} if ``following``, as the warnings read it) of a one-parameter expansion at one
+    float value p, in plain floats: the single-point path of :func:`omega_values` and of the assumption check of
+    :func:`~lindstedt.results._values.read`, in one pass; None wherever that path would do more than accept
+    compiled values or stable series that exist already (then the caller takes the general path, which decides
+    the same way and raises, repairs exactly or generates what is missing).
+
+    One evaluation of the core family (:func:`~lindstedt.results._values.core_family`: the assumptions' conditions
+    and ω_0 … ω_M, the straight-line scalar form of :meth:`lindstedt.compiled.family.BoundedFamily.scalar`) per new
+    p, kept for the last _SCALAR_MEMORY values.  A condition's sign is taken where |value| exceeds its rounding bound
+    (as :meth:`~lindstedt.results.assumptions.Assumptions.float_verdict`); an undecided or violated one, an
+    assumption without a float form, a coefficient not finite, or one whose bound exceeds the tolerance without a
+    stable series gives None.  Only after the general path probed the grid for these orders (its first call).
+    """
+    state = expansion._floats
+    cache = state.cache
+    if cache.get(("probed", COEFFICIENT_TOLERANCE), -1) < last or (following and cache.get(("probed", WARNING_TOLERANCE), -1) <= last):
+        return None
+    memory = cache.get("scalar omegas")
+    if memory is None:
+        memory = cache["scalar omegas"] = OrderedDict()
+    entry = memory.get(value, memory)  # the dict itself marks a miss (None is an entry: general path)
+    if entry is memory:
+        entry = memory[value] = _scalar_entry(expansion, value)
+        if len(memory) > _SCALAR_MEMORY:
+            memory.popitem(last=False)
+    if entry is None or entry[3] < last + following:
+        return None
+    accepted, raw, bounds, _ = entry
+    coefficients = accepted[: last + 1]
+    if None in coefficients:
+        return None
+    if not following:
+        return coefficients
+    next_value = raw[last + 1]
+    if not bounds[last + 1] <= WARNING_TOLERANCE * abs(next_value):
+        next_value = _stable_value(expansion, last + 1, value)
+    return None if next_value is None else [*coefficients, next_value]
+
+
+def _scalar_entry(expansion: Any, value: float) -> tuple[list[float | None], list[float], list[float], int] | None:
+    """(ω_k accepted at COEFFICIENT_TOLERANCE or from an existing stable series, else None; the compiled ω_k; their
+    bounds; M) at p = value, or None if the assumptions are not decided true there in floats."""
+    assumptions = expansion._assumptions
+    if assumptions._integers or assumptions._inexpressible:
+        return None
+    family, conditions, highest = core_family(expansion)
+    point = None if family is None else family.scalar(value)
+    if point is None:
+        return None
+    values, bounds = point
+    for number, bound, allowed in zip(values[:conditions], bounds[:conditions], assumptions._condition_rows[1].tolist()):
+        if not (abs(number) > bound or (number == 0 and bound == 0)) or not allowed[(number > 0) - (number < 0) + 1]:
+            return None
+    raw, errors = values[conditions:], bounds[conditions:]
+    accepted: list[float | None] = []
+    for k, (number, bound) in enumerate(zip(raw, errors)):
+        if not bound <= COEFFICIENT_TOLERANCE * abs(number):
+            number = _stable_value(expansion, k, value)
+        accepted.append(number if number is not None and math.isfinite(number) else None)
+    return accepted, raw, errors, highest
+
+
+def _stable_value(expansion: Any, k: int, value: float) -> float | None:
+    """ω_k at p from its stable series if it exists and is finite there, else None."""
+    stable = expansion._floats.cache.get("stable", {}).get(k)
+    if stable is None:
+        return None
+    number = float(stable.scalar(value))
+    return number if math.isfinite(number) else None
 
 
 def _accepted(expansion: Any, values: np.ndarray | None, bounds: np.ndarray | None, indices: Any, point: Point,

@@ -27,7 +27,7 @@ from .._precision import locked
 from ..problems.parsing import parse_real
 from .assumptions import check_names, shown_values
 
-__all__ = ["GRID_CELLS", "UNSET", "FloatState", "Point", "finite", "floats", "grid_cell", "omega_expr", "omega_known",
+__all__ = ["GRID_CELLS", "UNSET", "FloatState", "Point", "core_family", "finite", "floats", "grid_cell", "omega_expr", "omega_known",
            "parameter_grid", "probe_points", "read", "substitution", "to_float", "values_key"]
 
 _MEMORY = 64  # scalar parameter points whose float data an expansion keeps
@@ -229,7 +229,7 @@ def _check_point(expansion: Any, point: Point) -> None:
     exactly, which raises the ParameterError naming the regime."""
     if point.cache.get("checked"):
         return
-    family, conditions, highest = _core(expansion)
+    family, conditions, highest = core_family(expansion)
     values, bounds = family(*point.arrays) if family is not None else (None, None)
     assumptions = expansion._assumptions
     if values is None and conditions:
@@ -245,7 +245,7 @@ def _check_point(expansion: Any, point: Point) -> None:
     point.cache["checked"] = True
 
 
-def _core(expansion: Any) -> tuple[Any, int, int]:
+def core_family(expansion: Any) -> tuple[Any, int, int]:
     """(family, number of assumption conditions, M): one compiled family for the assumptions' conditions
     and ω_0 … ω_M (M = N, or N + 1 once ω_{N+1} is derived), evaluated once per new parameter point."""
     last = expansion._steps * expansion.order
@@ -272,7 +272,7 @@ def parameter_grid(expansion: Any) -> tuple[np.ndarray, np.ndarray] | None:
             with np.errstate(divide="ignore"):
                 nodes = s / (1 - np.abs(s))
             valid = np.isfinite(nodes)
-            family, conditions, _ = _core(expansion)
+            family, conditions, _ = core_family(expansion)
             if family is None and conditions:
                 valid[:] = False
             elif conditions:
