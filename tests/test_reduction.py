@@ -201,3 +201,34 @@ def test_irrational_exact_entries_keep_the_working_precision():
     plain = ResidualFlexibility(modes=3).reduce((chain.M_exact, chain.K_exact), A=chain.A_exact)
     for a, b in zip(scaled.frequencies, plain.frequencies):
         assert abs(a / b - mpmath.root(2, 4)) < mpmath.mpf(10) ** -28
+
+
+@pytest.mark.slow
+def test_reduced_forced_orbit_in_contact_converges_to_the_full_models():
+    # the string-scaled 100-mass chain between two stops, forced at its first frequency hard enough to hit the stop
+    # at mass 25: the full model's periodic orbit (exact event-driven flow, checked by an independent DOP853 period)
+    # against the reduced models' (K modes + the residual vectors of the stops and the load). A string's modes sit
+    # near the harmonics of the response (λ_k ≈ k λ₁), so the truncation converges only algebraically in K: the
+    # fitted order must be positive and steep, the error at K = 16 small
+    n = 100
+    system = UnilateralSystem.chain(n, unilateral=[(n // 4, 1), (3 * n // 4, 1, -1)], mass=f"1/{n + 1}", stiffness=n + 1)
+    load = [sympy.Integer(0)] * n
+    load[n // 2] = sympy.Rational(1, 20)
+    lam1 = float(system.modes().frequencies[0])
+    rayleigh, frequency, eps = (0.01 * lam1, 0.01 / lam1), lam1, 10.0
+    full = lindstedt.forced_periodic_orbit(lindstedt.ForcedSystem(system, load, rayleigh=rayleigh), frequency, epsilon=eps)
+    assert full.success, full.message
+    assert full.maximum[n // 4] > 1.05  # in contact with the stop
+    errors = []
+    for modes in (4, 8, 16):
+        reduced = ResidualFlexibility(modes=modes).reduce((system.M_exact, system.K_exact), A=system.A_exact,
+                                                          b=list(system.b_exact), loads=load)
+        start = np.linalg.lstsq(reduced.basis, full.state.reshape(2, n).T, rcond=None)[0].T.ravel()
+        orbit = lindstedt.forced_periodic_orbit(lindstedt.ForcedSystem(reduced.system, list(reduced.loads[0]),
+                                                                       rayleigh=rayleigh),
+                                                frequency, epsilon=eps, initial_state=start)
+        assert orbit.success, orbit.message
+        displacement = reduced.basis @ orbit.state[:reduced.system.n_dof]
+        errors.append(np.max(np.abs(displacement - full.state[:n])) / np.max(np.abs(full.state[:n])))
+    order = -np.polyfit(np.log([4, 8, 16]), np.log(errors), 1)[0]
+    assert order > 2 and errors[-1] < 1e-3, (order, errors)
