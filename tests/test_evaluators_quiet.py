@@ -59,3 +59,41 @@ def test_new_kappa_values_match_the_array_path(gap: lindstedt.Expansion) -> None
     table = gap.frequency_coefficients({"kappa": kappas})
     for index, kappa in enumerate(kappas):
         np.testing.assert_allclose(gap.frequency_coefficients({"kappa": float(kappa)}), table[:, index], rtol=2e-14, atol=0)
+
+
+def test_no_warning_lost_next_to_the_regime_ends(gap: lindstedt.Expansion) -> None:
+    """Where the quiet radius runs to 0 or ∞ (κ → ∓1) and around the nodes of a uniform grid in
+    s = κ/(1 + |κ|) (256 cells, where a tabulated bound would change): a warning just beyond the exact radius
+    from the orbit at that κ, none well inside."""
+    edges = [sign * (1 - 2.0**-k) for sign in (1, -1) for k in range(1, 27)]  # the exact range resolves 1 + κ > 4e-9
+    s = -1 + 2 * np.arange(65, 192) / 256  # the grid nodes with |κ| < 1, approached from both sides
+    nodes = s / (1 - np.abs(s))
+    for kappa in [*edges, *np.nextafter(nodes, -2), *np.nextafter(nodes, 2)][::2]:
+        kappa = float(kappa)
+        bounds = gap.epsilon_range({"kappa": kappa})
+        quiet = min(bounds.upper, -bounds.lower, bounds.radius)
+        if kappa <= 0:  # the closed form (module docstring)
+            assert quiet == pytest.approx((1 + kappa) / (1 - kappa), rel=1e-9)
+        assert _speaks(gap, -1.02 * quiet, kappa)
+        if quiet < 0.5:  # beyond ε = 1/2 the series' own terms speak first
+            assert _speaks(gap, 1.02 * quiet, kappa)
+        if quiet > 1e-3:
+            assert not _speaks(gap, 1e-3 * quiet, kappa)
+
+
+def test_one_point_frequency_matches_the_exact_coefficients(gap: lindstedt.Expansion) -> None:
+    """ω(ε) at κ new to the expansion, one float at a time (the one-pass path), against the 30-digit Cauchy-integral
+    coefficients of the exact period: within 1e-13 of the terms plus the reference's own estimate; and the same
+    numbers as the array path at the same κ."""
+    from lindstedt.references import piecewise_linear_frequency_taylor
+
+    kappas = [-0.95, -0.6180339887, -0.123, 0.0, 0.3, 0.7071067811865476, 0.93, 0.999999]
+    epsilon = 0.01
+    array = gap.frequency(epsilon, values={"kappa": np.array(kappas)})
+    for index, kappa in enumerate(kappas):
+        reference = piecewise_linear_frequency_taylor(2, a=1, b=kappa, a0=1, precision=30)
+        exact = sum(float(value) * epsilon**k for k, (value, _) in enumerate(reference))
+        allowance = sum((1e-13 * abs(float(value)) + float(error)) * epsilon**k for k, (value, error) in enumerate(reference))
+        value = gap.frequency(epsilon, values={"kappa": kappa})
+        assert abs(value - exact) <= allowance + 4e-16
+        assert value == pytest.approx(array[index], rel=1e-14)

@@ -53,7 +53,6 @@ from .orbit_range import OrbitRange, orbit_range, range_function
 __all__ = ["coefficients", "displacement_error_estimate", "epsilon_range", "evaluate", "frequency", "truncation_error_estimate"]
 
 _RANGE_MEMORY = 4096  # parameter points whose OrbitRange an expansion keeps (small objects)
-_QUIET_MARGIN = 0.8  # a cell of the quiet table accepts |ε| below this fraction of its interpolated lower bound
 
 
 def _horner(points: Any, coefficients: np.ndarray) -> Any:
@@ -343,15 +342,27 @@ def _range_at(expansion: Any, arguments: tuple[float, ...], source: Any = UNSET)
 # 1.1 ms median of .frequency(0.05, values={"kappa": new}) on Max(0, u - kappa), order 3, before the table), a
 # hundred times the arithmetic of the evaluation.  So the quiet radius q(p) = min(upper, −lower, radius) — below
 # which judge() says nothing — is computed once per expansion on the valid nodes of parameter_grid (127 for a gap
-# κ in (−1, 1): 0.13 s), and cell j (nodes j, j + 1) accepts
-#     |ε| < _QUIET_MARGIN (min(q_j, q_{j+1}) − max(|Δ²q_j|, |Δ²q_{j+1}|)),   Δ²q_j = q_{j−1} − 2 q_j + q_{j+1},
-# without an OrbitRange: for a smooth q the linear interpolant errs by about |Δ²q|/8 inside the cell, and a kink or
-# a jump (two events crossing, a regime change) makes Δ²q as large as the jump, so the bound drops to nothing
-# there.  A sampled bound, not a proven one: checked against the exact OrbitRange at 20 000 random κ for
-# Max(0, u - kappa) and 3 000-5 000 p for alpha*u**3, kappa*Max(0, u - 1/2), u**3 + kappa*u**2 (no p where the
-# table accepted an ε the OrbitRange would warn about; tests/test_evaluators_quiet.py checks 300 κ on every run).
-# Every other ε or p takes the exact OrbitRange as before.
-def _quiet_table(expansion: Any) -> np.ndarray | None:
+# κ in (−1, 1): 0.13 s), and cell j (nodes j, j + 1), with its neighbourhood W_j = {q_{j−1}, q_j, q_{j+1}, q_{j+2}},
+# accepts without an OrbitRange
+#     |ε| < min W_j / _QUIET_RATIO      where max W_j ≤ _QUIET_RATIO min W_j  (else nothing: the exact OrbitRange),
+# and every |ε| where q is +inf at all four nodes.  Why this is conservative: a warning missed at p in cell j needs
+# q(p) ≤ |ε| < min W_j / 2, i.e. q falling inside one cell to below half its smallest value at the four nodes
+# around it, while those four values (three cells) agree within a factor 2.  q is the distance in ε to the nearest
+# event of the orbit (a grazing, an escape, a singularity of ω(ε)); where those events move continuously with p, q
+# is continuous (a min of continuous functions: kinks where two events cross, no dips), and such a factor needs a
+# feature narrower than one cell (Δs = 1/128 in s = p/(1 + |p|)).  Where the set of events changes (the regime's
+# end, κ → ±a0 of a gap: q → 0 or ∞; a law whose stiffness changes sign) q varies by more than 2× over a few cells
+# or is missing (a node outside the regime, no orbit, +inf next to a finite q): those cells accept nothing.  So a
+# miss needs an event that appears and disappears again inside one cell.  Checked against the exact OrbitRange (no
+# miss; the smallest q / bound 2.02): Max(0, u - kappa) at 20 000 random p (s uniform; 9 291 accepted by the table)
+# and κ = ±(1 − 2^−k), k = 1 … 40 (q = (1 + κ)/(1 − κ) for κ ≤ 0, where the breakpoint becomes the lower turning
+# point; 1/(1 − κ) measured for κ > 0: a kink at κ = 0), alpha*u**3, kappa*Max(0, u - 1/2) and u**3 + kappa*u**2 at
+# 3 000 random p each; tests/test_evaluators_quiet.py checks on every run that a warning comes just beyond q at
+# 300 random κ and 167 κ next to ±1 and at the cells' edges.  Every other ε or p takes the exact OrbitRange.
+_QUIET_RATIO = 2.0
+
+
+def _quiet_table(expansion: Any) -> list[float] | None:
     """Per cell of :func:`parameter_grid`: the |ε| below which the expansion needs no warning (0: none known)."""
     cache = expansion._floats.cache
     if "quiet" not in cache:
@@ -359,7 +370,7 @@ def _quiet_table(expansion: Any) -> np.ndarray | None:
     return cache["quiet"]
 
 
-def _build_quiet(expansion: Any) -> np.ndarray | None:
+def _build_quiet(expansion: Any) -> list[float] | None:
     grid = parameter_grid(expansion)
     if grid is None or _range_source(expansion) is None:
         return None
@@ -372,16 +383,14 @@ def _build_quiet(expansion: Any) -> np.ndarray | None:
             continue
         quiet = min(bounds.upper, -bounds.lower, bounds.radius)
         radii[index] = quiet if quiet > 0 else np.nan
-    # cell j lies between nodes j and j + 1; its neighbourhood is nodes j - 1 ... j + 2
+    # cell j lies between nodes j and j + 1; its neighbourhood is nodes j - 1 ... j + 2 (NaN beyond the ends)
     padded = np.concatenate([[np.nan], radii, [np.nan]])
     windows = np.lib.stride_tricks.sliding_window_view(padded, 4)[: len(nodes) - 1]
     with np.errstate(invalid="ignore"):
-        curvature = np.maximum(np.abs(windows[:, 0] - 2 * windows[:, 1] + windows[:, 2]),
-                               np.abs(windows[:, 1] - 2 * windows[:, 2] + windows[:, 3]))
-        bound = _QUIET_MARGIN * (np.minimum(windows[:, 1], windows[:, 2]) - curvature)
-        table = np.where(np.isfinite(bound) & (bound > 0), bound, 0.0)
-    table[np.isinf(windows).all(axis=1)] = np.inf  # no event anywhere near
-    return table
+        low, high = windows.min(axis=1), windows.max(axis=1)  # NaN where a node is missing
+        table = np.where(np.isfinite(high) & (high <= _QUIET_RATIO * low), low / _QUIET_RATIO, 0.0)
+    table[np.isposinf(windows).all(axis=1)] = np.inf  # no event at any of the four nodes
+    return table.tolist()
 
 
 def _quiet(expansion: Any, epsilon: Any, point: Point) -> bool:
@@ -393,7 +402,7 @@ def _quiet(expansion: Any, epsilon: Any, point: Point) -> bool:
     if not point.shape:
         limit = table[grid_cell(float(value))]
         return bool(abs(epsilon) < limit) if isinstance(epsilon, float) else bool(np.all(np.abs(epsilon) < limit))
-    return bool(np.all(np.abs(epsilon) < table[grid_cell(value)]))
+    return bool(np.all(np.abs(epsilon) < np.asarray(table)[grid_cell(value)]))
 
 
 def _range_message(expansion: Any, epsilon: Any, point: Point | None, values: Mapping[Any, Any] | None) -> str | None:
