@@ -215,15 +215,16 @@ _NNM_MEMORY = (3.5e-4, 12.0)
 
 
 #: Elements of other laws (measured on chains with a gap spring and one element, a0 = 3, this machine):
-#: a Hertz contact arc costs ``_NNM_ARC · N · (order + 1)`` s (mpmath Chebyshev integrals at 128 nodes per component
-#: and order: 0.22 s at N = 5, order 1; 9.98 s at N = 20, order 3); products of branches (powers ≥ 2, analytic laws)
+#: a Hertz contact arc costs ``_NNM_ARC · N · (order + 1)`` s (Chebyshev integrals at 128 nodes per component and
+#: order, the transforms in fixed point; a Hertz element between two masses of a unit chain, a0 = 1: 0.39 s at N = 5,
+#: order 1; 0.74 s at N = 20, order 1; 1.43 s at N = 40, order 1; 8.2 s at N = 40, order 2 — the former 0.12 was
+#: measured before the fixed-point transforms and overestimated 4–7×); products of branches (powers ≥ 2, analytic laws)
 #: cost ``_NNM_PRODUCTS · N^1.6 · 9^(order − 2)`` s from order 3 on (combination tones of the N modal frequencies:
 #: sin(u) with a crossing, 1.28 s at N = 5, order 3; 11.9 s at N = 5, order 4; 12.1 s at N = 20, order 3); order 2
 #: stays linear in N (0.77 s for a cubic spring at N = 200).  An analytic contact arc without a fractional power
-#: (Chebyshev series in 1 − τ itself, which converge on fewer nodes) costs ``_NNM_ANALYTIC_ARC · N · (order + 1)`` s
-#: (``Max(0, u - 1/5)*exp(u)`` on the middle mass of a chain with a gap spring, a0 = 3: 0.13 s at N = 5, order 1;
-#: 1.7 s at N = 20, order 2; 6.4 s at N = 40, order 3).
-_NNM_ARC, _NNM_ANALYTIC_ARC, _NNM_PRODUCTS = 0.12, 0.03, 0.015
+#: costs the same per dof and order (``Max(0, u - 1/5)*exp(u)`` on the middle mass of a chain with a gap spring,
+#: a0 = 3: 0.13 s at N = 5, order 1; 1.7 s at N = 20, order 2; 6.4 s at N = 40, order 3).
+_NNM_ARC, _NNM_PRODUCTS = 0.03, 0.015
 
 
 def _law_costs(system: Any) -> tuple[float, bool]:
@@ -242,10 +243,9 @@ def _law_costs(system: Any) -> tuple[float, bool]:
             intervals = decompose_piecewise(law, LAW_VARIABLE)
         except LindstedtError:  # refused by the method itself, with its own words
             continue
-        if any(interval.fractional for interval in intervals):
+        if any(interval.fractional for interval in intervals) or (
+                len(intervals) > 1 and any(interval.analytic != 0 for interval in intervals)):
             arc = _NNM_ARC
-        elif len(intervals) > 1 and any(interval.analytic != 0 for interval in intervals):
-            arc = max(arc, _NNM_ANALYTIC_ARC)
         # an analytic part next to a breakpoint multiplies on its arc (priced above), one without breakpoints branches
         products = products or any(len(interval.coefficients) > 2 for interval in intervals) or \
             (len(intervals) == 1 and intervals[0].analytic != 0)
