@@ -90,7 +90,6 @@ from typing import Any, Callable
 
 import numpy as np
 import sympy
-from scipy.optimize import brentq
 
 from .._errors import ParameterError, UnsupportedNonlinearityError
 from ..problems.oscillator import DISPLACEMENT, Oscillator
@@ -272,6 +271,8 @@ class _Piece:
 
 
 def _refine(function: Callable[[float], float], a: float, b: float) -> float:
+    from scipy.optimize import brentq  # here: importing scipy.optimize costs ~0.3 s, and most orbits need no root
+
     return float(brentq(function, a, b, xtol=1e-15 * max(abs(a), abs(b), 1e-300), rtol=4 * np.finfo(float).eps, maxiter=200))
 
 
