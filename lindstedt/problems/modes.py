@@ -2,7 +2,8 @@
 
 * :func:`_float_modes` — λ and Φ in float64 by LAPACK (tridiagonal or banded solvers when ``M`` is
   diagonal), each shape signed so that its first entry of largest magnitude is positive;
-* :func:`_refined_modes` — those modes refined in fixed-point arithmetic on Python ints: with the exact
+* :func:`_refine` — those modes refined in fixed-point arithmetic on Python ints, a block of modes at a time
+  (:func:`_refined_blocks`; O(N · block) ints in memory): with the exact
   residuals ``R = K X − M X Θ`` (products with the band of K and M), each sweep corrects every mode by its
   projections on the float modes, ``x_k −= Σ_{l≠k} x̃_l (x̃_lᵀ r_k)/(θ_l − θ_k)``, and θ_k is the final
   Rayleigh quotient; :func:`_dense_mpmath_modes` — the dense mpmath decomposition, the fallback for
@@ -192,14 +193,26 @@ class _RefinedModes(NamedTuple):
         return rows
 
 
-def _refined_modes(system: _ExactSystem, digits: int) -> _RefinedModes | None:
-    """The float modes of :meth:`UnilateralSystem.modes` refined to ``digits`` digits (see ``modal_coupling``).
+class _Refinement(NamedTuple):
+    """What every block of modes shares in :func:`_refine`: the float modes, the gaps, the precision, the bands."""
 
-    Fixed-point arithmetic on Python ints (X = ints · 2^-p): the residual of every mode is formed exactly
-    from the band of K and M (integer entries exactly, others to 2^-(p+64)), rounded to float64 and
-    projected on the float modes.  None when two θ_k coincide, when a sweep would gain fewer than 4 bits
-    (``log2(θ_max/gap) > 44``) or the sweeps do not converge (the caller then decomposes densely in mpmath).
-    """
+    shapes: np.ndarray
+    theta_float: np.ndarray
+    gaps: np.ndarray
+    magnitude: float
+    largest: float
+    target: int
+    gain: float
+    bits: int
+    p: int
+    stiffness: _Band
+    mass: _Band
+
+
+def _refinement(system: _ExactSystem, digits: int) -> _Refinement | None:
+    """The set-up of :func:`_refine` (see ``modal_coupling``), or None when the sweeps cannot converge: two θ_k
+    coincide, or a sweep would gain fewer than 4 bits (``log2(θ_max/gap) > 44``); the caller then decomposes
+    densely in mpmath."""
     frequencies, shapes = system.modes()
     theta_float = frequencies**2
     n = system.n_dof
@@ -221,30 +234,65 @@ def _refined_modes(system: _ExactSystem, digits: int) -> _RefinedModes | None:
     # shapes to 2^-p relative to their largest entry, and a sweep's residual loses log2(θ_max/gap)
     bits = target + int(np.ceil(max(0.0, np.log2(max(1.0, largest) / float(theta_float[0]))) + conditioning)) + 16
     p = bits + max(0, int(np.ceil(np.log2(max(1.0, magnitude) / min(np.max(np.abs(shapes), axis=0))))))
-    stiffness = _Band.of(system.K_exact, p)
-    mass = _Band.of(system.M_exact, p)
-    start = 62 - int(np.ceil(np.log2(magnitude)))
-    X = np.rint(np.ldexp(shapes, start)).astype(np.int64).astype(object) << (p - start)
-    theta = np.array([int(v) for v in np.rint(np.ldexp(theta_float, 52 - int(np.ceil(np.log2(largest)))))], dtype=object)
-    theta = theta << (p - 52 + int(np.ceil(np.log2(largest))))
-    for _ in range(int(np.ceil((target - 40) / gain)) + 3):
-        KX = stiffness.times(X)
-        MX = X if mass.identity else mass.times(X)
+    return _Refinement(shapes, theta_float, gaps, magnitude, largest, target, gain, bits, p,
+                       _Band.of(system.K_exact, p), _Band.of(system.M_exact, p))
+
+
+#: modes refined together: the fixed-point shapes of a block are O(N · block) ints (all N at once: 436 MB for the NNM
+#: of a 1000-dof chain; blocks of 128: 118 MB, CPU within the noise of one block — blocks of 64 cost 25 % more, the
+#: (N × N) @ (N × block) float products of a sweep running below BLAS speed)
+_BLOCK = 128
+
+
+def _refine(setup: _Refinement, columns: slice) -> _RefinedModes | None:
+    """The float modes ``columns`` refined to the set-up's precision (see ``modal_coupling``).
+
+    Fixed-point arithmetic on Python ints (X = ints · 2^-p): the residual of every mode is formed exactly
+    from the band of K and M (integer entries exactly, others to 2^-(p+64)), rounded to float64 and
+    projected on all the float modes.  None when the sweeps do not converge.
+    """
+    shapes, p, target = setup.shapes, setup.p, setup.target
+    block = shapes[:, columns]
+    indices = np.arange(shapes.shape[1])[columns]
+    start = 62 - int(np.ceil(np.log2(setup.magnitude)))
+    X = np.rint(np.ldexp(block, start)).astype(np.int64).astype(object) << (p - start)
+    scale = int(np.ceil(np.log2(setup.largest)))
+    theta = np.array([int(v) for v in np.rint(np.ldexp(setup.theta_float[indices], 52 - scale))], dtype=object)
+    theta = theta << (p - 52 + scale)
+    gaps = setup.gaps[:, indices]
+    for _ in range(int(np.ceil((target - 40) / setup.gain)) + 3):
+        KX = setup.stiffness.times(X)
+        MX = X if setup.mass.identity else setup.mass.times(X)
         residual = _to_float(KX - ((MX * theta[None, :]) >> p), p)
         projections = shapes.T @ residual  # x̃_lᵀ r_k ≈ (θ_l − θ_k) δ_lk, and θ*_k − θ_k on the diagonal
-        update = np.diag(projections)
+        update = projections[indices, np.arange(len(indices))]
         theta = theta + _to_fixed(update, p)
         correction = shapes @ (-projections / gaps)
         X = X + _to_fixed(correction, p)
-        if np.max(np.abs(correction)) <= 2.0**-target * magnitude:
+        if np.max(np.abs(correction)) <= 2.0**-target * setup.magnitude:
             break
     else:
         return None
-    KX = stiffness.times(X)
-    MX = X if mass.identity else mass.times(X)
+    KX = setup.stiffness.times(X)
+    MX = X if setup.mass.identity else setup.mass.times(X)
     norms = [int(v) for v in (X * MX).sum(axis=0)]
     numerators = [int(v) for v in (X * KX).sum(axis=0)]  # Rayleigh quotients: error ~ (shape error)²
-    return _RefinedModes(X, norms, numerators, bits)
+    return _RefinedModes(X, norms, numerators, setup.bits)
+
+
+def _refined_blocks(system: _ExactSystem, digits: int) -> list[_RefinedModes] | None:
+    """The modes of :meth:`UnilateralSystem.modes` refined to ``digits`` digits, block by block (None: the caller
+    falls back to the dense mpmath decomposition)."""
+    setup = _refinement(system, digits)
+    if setup is None:
+        return None
+    blocks = []
+    for first in range(0, system.n_dof, _BLOCK):
+        refined = _refine(setup, slice(first, min(first + _BLOCK, system.n_dof)))
+        if refined is None:
+            return None
+        blocks.append(refined)
+    return blocks
 
 
 def _to_float(values: np.ndarray, p: int) -> np.ndarray:
@@ -287,21 +335,24 @@ def _dense_mpmath_modes(system: _ExactSystem, digits: int) -> tuple[list[Any], l
 
 def _high_precision_modes(system: _ExactSystem, digits: int) -> tuple[list[Any], list[list[Any]]]:
     """λ_k and the shapes of :meth:`~lindstedt.problems.system.UnilateralSystem.modes_high_precision`."""
-    refined = _refined_modes(system, digits)
-    if refined is None:
+    blocks = _refined_blocks(system, digits)
+    if blocks is None:
         return _dense_mpmath_modes(system, digits)
-    with workprec(refined.bits):
-        frequencies = refined.frequencies()
-        roots = [mpmath.sqrt(norm) for norm in refined.norms]
-        shapes = [[mpmath.mpf(int(value)) / root for value in refined.X[:, k]] for k, root in enumerate(roots)]
+    frequencies: list[Any] = []
+    shapes: list[list[Any]] = []
+    with workprec(blocks[0].bits):
+        for refined in blocks:
+            frequencies += refined.frequencies()
+            roots = [mpmath.sqrt(norm) for norm in refined.norms]
+            shapes += [[mpmath.mpf(int(value)) / root for value in refined.X[:, k]] for k, root in enumerate(roots)]
     with workdps(digits):
         return [+value for value in frequencies], [[+value for value in column] for column in shapes]
 
 
 def _modal_coupling(system: _ExactSystem, digits: int) -> tuple[list[Any], list[list[Any]], list[list[Any]]]:
     """λ_k, ``B = A Φ`` and ``G = Φᵀ W`` of :meth:`~lindstedt.problems.system.UnilateralSystem.modal_coupling`."""
-    refined = _refined_modes(system, digits)
-    if refined is None:
+    blocks = _refined_blocks(system, digits)
+    if blocks is None:
         frequencies, columns = _dense_mpmath_modes(system, digits)
         with workdps(digits + 10):
             A = [[_exact_mpf(v) for v in row] for row in system.A_exact.tolist()]
@@ -310,9 +361,17 @@ def _modal_coupling(system: _ExactSystem, digits: int) -> tuple[list[Any], list[
             G = [[+mpmath.fdot(column, (W[r][i] for r in range(system.n_dof))) for i in range(system.n_springs)] for column in columns]
         with workdps(digits):
             return frequencies, [[+v for v in row] for row in B], [[+v for v in row] for row in G]
-    with workprec(refined.bits):
-        frequencies = refined.frequencies()
-        B = refined.projections(system.A_exact)
-        G = [list(column) for column in zip(*refined.projections(system.W_exact.T))] if system.n_springs else [[] for _ in range(system.n_dof)]
+    frequencies = []
+    B = [[] for _ in range(system.A_exact.rows)]
+    G: list[list[Any]] = []
+    with workprec(blocks[0].bits):
+        for refined in blocks:  # the block's shapes are dropped once projected: O(N · block) ints at a time
+            frequencies += refined.frequencies()
+            for row, values in zip(B, refined.projections(system.A_exact)):
+                row += values
+            if system.n_springs:
+                G += [list(column) for column in zip(*refined.projections(system.W_exact.T))]
+            else:
+                G += [[] for _ in range(refined.X.shape[1])]
     with workdps(digits):
         return [+value for value in frequencies], [[+value for value in row] for row in B], [[+value for value in row] for row in G]
