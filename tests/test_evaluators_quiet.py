@@ -97,3 +97,34 @@ def test_one_point_frequency_matches_the_exact_coefficients(gap: lindstedt.Expan
         value = gap.frequency(epsilon, values={"kappa": kappa})
         assert abs(value - exact) <= allowance + 4e-16
         assert value == pytest.approx(array[index], rel=1e-14)
+
+
+def _outcome(expansion: lindstedt.Expansion, epsilon: float, kappa: object) -> tuple[str, float]:
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            value = float(np.ravel(expansion.frequency(epsilon, values={"kappa": kappa}))[0])
+        except lindstedt.ParameterError:
+            return "error", float("nan")
+    warned = any(issubclass(w.category, lindstedt.ExpansionValidityWarning) for w in caught)
+    return ("warning" if warned else "quiet"), value
+
+
+def test_one_point_path_decides_as_the_array_path(gap: lindstedt.Expansion) -> None:
+    """At 300 random (ε, κ), κ new to the expansion, ε on both sides of every radius: one float κ (the one-pass path
+    where it applies) and the same κ as a one-element array (the vectorised path) give the same value and the same
+    verdict: quiet, a warning, or the error of no orbit."""
+    rng = np.random.default_rng(2026)
+    verdicts = set()
+    for epsilon, kappa in zip(rng.uniform(-0.6, 0.6, 300), rng.uniform(-1.05, 1.05, 300)):
+        epsilon, kappa = float(epsilon), float(kappa)
+        if abs(kappa) >= 1:  # outside the regime: both raise
+            with pytest.raises(lindstedt.ParameterError):
+                gap.frequency(epsilon, values={"kappa": kappa})
+            continue
+        single, array = _outcome(gap, epsilon, kappa), _outcome(gap, epsilon, np.array([kappa]))
+        assert single[0] == array[0]
+        if single[0] != "error":
+            assert single[1] == pytest.approx(array[1], rel=1e-14)
+        verdicts.add(single[0])
+    assert verdicts == {"quiet", "warning"} or verdicts == {"quiet", "warning", "error"}

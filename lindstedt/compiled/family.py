@@ -5,6 +5,8 @@ shifts, the signs an expansion's derivation assumed) once into a :class:`Bounded
 evaluator that returns, with the values, a bound ``|fl(e) − e| ≤ bound`` to first order in the unit roundoff;
 the float evaluators of :class:`~lindstedt.Expansion` accept a value where the bound is small and recompute it
 exactly (or by the stable series of :mod:`lindstedt.compiled.stable_series`) where the closed form cancels.
+At one point (:meth:`BoundedFamily.scalar`) the same values and bounds come from plain floats: the atoms term by
+term and each block as one generated straight-line function (no NumPy call per point).
 """
 
 from __future__ import annotations
