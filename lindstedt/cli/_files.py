@@ -13,7 +13,7 @@ the work starts, so that a request either finishes in predictable time and memor
 
 ``N_max`` and ``S_max`` are the options ``--max-dof`` and ``--max-springs`` (default :data:`MAX_DOF` and
 :data:`MAX_SPRINGS`: measured on two cores, a 100-dof chain takes 0.6 s and 100 MB for an NNM expansion,
-0.9 s for ``--numeric`` and 28 s, 270 MB for a ``forced`` sweep; a 1000-dof chain already takes 6 s and 550 MB for
+0.9 s for ``--numeric`` and 28 s, 270 MB for a ``forced`` sweep; a 1000-dof chain already takes 7 s and 120 MB for
 the expansion, and its sweep more than a minute).
 """
 
