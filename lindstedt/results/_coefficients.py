@@ -119,15 +119,20 @@ def scalar_omegas(expansion: Any, value: float, last: int, following: bool) -> l
 def _scalar_entry(expansion: Any, value: float) -> tuple[list[float | None], list[float], list[float], int] | None:
     """(ω_k accepted at COEFFICIENT_TOLERANCE or from an existing stable series, else None; the compiled ω_k; their
     bounds; M) at p = value, or None if the assumptions are not decided true there in floats."""
-    assumptions = expansion._assumptions
-    if assumptions._integers or assumptions._inexpressible:
-        return None
-    family, conditions, highest = core_family(expansion)
+    cache = expansion._floats.cache
+    setup = cache.get("one point")
+    if setup is None or setup[2] <= expansion._steps * expansion.order:  # final once ω_{N+1} is in the core
+        assumptions = expansion._assumptions
+        family, conditions, highest = core_family(expansion)
+        if assumptions._integers or assumptions._inexpressible:
+            family = None
+        setup = cache["one point"] = (family, conditions, highest, assumptions._condition_rows[1].tolist())
+    family, conditions, highest, signs = setup
     point = None if family is None else family.scalar(value)
     if point is None:
         return None
     values, bounds = point
-    for number, bound, allowed in zip(values[:conditions], bounds[:conditions], assumptions._condition_rows[1].tolist()):
+    for number, bound, allowed in zip(values[:conditions], bounds[:conditions], signs):
         if not (abs(number) > bound or (number == 0 and bound == 0)) or not allowed[(number > 0) - (number < 0) + 1]:
             return None
     raw, errors = values[conditions:], bounds[conditions:]

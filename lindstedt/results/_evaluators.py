@@ -131,10 +131,11 @@ def _one_point_frequency(expansion: Any, epsilon: float, values: dict[Any, Any],
             return None
     if last >= 1:  # series_warning's comparisons at |η| = |ε|, in its order
         size = abs(epsilon)
-        terms = [abs(coefficient) * size**k for k, coefficient in enumerate(coefficients)]
+        powers = [size**k for k in range(last + 2)]
+        terms = [abs(coefficient) * power for coefficient, power in zip(coefficients, powers)]
         if last >= 3 and max(terms[last], terms[last + 1]) > max(terms[last - 2], terms[last - 1]):
             return None
-        if terms[last + 1] > max(abs(sum(coefficients[k] * size**k for k in range(1, last + 1))), 1e-300):
+        if terms[last + 1] > max(abs(sum([coefficients[k] * powers[k] for k in range(1, last + 1)])), 1e-300):
             return None
     total = 0.0
     for coefficient in coefficients[last::-1]:
