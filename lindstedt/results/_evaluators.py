@@ -345,22 +345,22 @@ def _range_at(expansion: Any, arguments: tuple[float, ...], source: Any = UNSET)
 # which judge() says nothing — is computed once per expansion on the valid nodes of parameter_grid (127 for a gap
 # κ in (−1, 1): 0.13 s), and cell j (nodes j, j + 1), with its neighbourhood W_j = {q_{j−1}, q_j, q_{j+1}, q_{j+2}},
 # accepts without an OrbitRange
-#     |ε| < min W_j / _QUIET_RATIO      where max W_j ≤ _QUIET_RATIO min W_j  (else nothing: the exact OrbitRange),
+#     |ε| < min W_j / max(2, ρ_j),   ρ_j = max W_j / min W_j ≤ _QUIET_SPREAD   (else nothing: the exact OrbitRange),
 # and every |ε| where q is +inf at all four nodes.  Why this is conservative: a warning missed at p in cell j needs
-# q(p) ≤ |ε| < min W_j / 2, i.e. q falling inside one cell to below half its smallest value at the four nodes
-# around it, while those four values (three cells) agree within a factor 2.  q is the distance in ε to the nearest
-# event of the orbit (a grazing, an escape, a singularity of ω(ε)); where those events move continuously with p, q
-# is continuous (a min of continuous functions: kinks where two events cross, no dips), and such a factor needs a
-# feature narrower than one cell (Δs = 1/128 in s = p/(1 + |p|)).  Where the set of events changes (the regime's
-# end, κ → ±a0 of a gap: q → 0 or ∞; a law whose stiffness changes sign) q varies by more than 2× over a few cells
-# or is missing (a node outside the regime, no orbit, +inf next to a finite q): those cells accept nothing.  So a
-# miss needs an event that appears and disappears again inside one cell.  Checked against the exact OrbitRange (no
-# miss; the smallest q / bound 2.02): Max(0, u - kappa) at 20 000 random p (s uniform; 9 291 accepted by the table)
-# and κ = ±(1 − 2^−k), k = 1 … 40 (q = (1 + κ)/(1 − κ) for κ ≤ 0, where the breakpoint becomes the lower turning
+# q(p) ≤ |ε| < min W_j / max(2, ρ_j), i.e. q falling inside one cell to below its smallest node value by a factor
+# larger than 2 and than the whole variation ρ_j seen over the four nodes (three cells) around it.  q is the
+# distance in ε to the nearest event of the orbit (a grazing, an escape, a singularity of ω(ε)); where those events
+# move continuously with p, q is continuous (a min of continuous functions: kinks where two events cross, no dips),
+# and such a factor needs a feature narrower than one cell (Δs = 1/128 in s = p/(1 + |p|)).  Where the set of
+# events changes (the regime's end, κ → ±a0 of a gap: q → 0 or ∞; a law whose stiffness changes sign) q varies by
+# more than _QUIET_SPREAD over a few cells or is missing (a node outside the regime, no orbit, +inf next to a
+# finite q): those cells accept nothing.  So a miss needs an event that appears and disappears again inside one
+# cell.  Checked against the exact OrbitRange (no miss; the smallest q / bound 2.02): Max(0, u - kappa) at 20 000
+# random p (s uniform; 9 602 accepted by the table) and κ = ±(1 − 2^−k), k = 1 … 40 (q = (1 + κ)/(1 − κ) for κ ≤ 0, where the breakpoint becomes the lower turning
 # point; 1/(1 − κ) measured for κ > 0: a kink at κ = 0), alpha*u**3, kappa*Max(0, u - 1/2) and u**3 + kappa*u**2 at
 # 3 000 random p each; tests/test_evaluators_quiet.py checks on every run that a warning comes just beyond q at
 # 300 random κ and 167 κ next to ±1 and at the cells' edges.  Every other ε or p takes the exact OrbitRange.
-_QUIET_RATIO = 2.0
+_QUIET_SPREAD = 16.0  # largest max/min of q over a cell's four nodes that the table accepts
 
 
 def _quiet_table(expansion: Any) -> list[float] | None:
@@ -389,7 +389,7 @@ def _build_quiet(expansion: Any) -> list[float] | None:
     windows = np.lib.stride_tricks.sliding_window_view(padded, 4)[: len(nodes) - 1]
     with np.errstate(invalid="ignore"):
         low, high = windows.min(axis=1), windows.max(axis=1)  # NaN where a node is missing
-        table = np.where(np.isfinite(high) & (high <= _QUIET_RATIO * low), low / _QUIET_RATIO, 0.0)
+        table = np.where(np.isfinite(high) & (high <= _QUIET_SPREAD * low), low / np.maximum(2.0, high / low), 0.0)
     table[np.isposinf(windows).all(axis=1)] = np.inf  # no event at any of the four nodes
     # OrbitRange.judge reaches np.unique at its first warning, and NumPy's first np.unique in a process imports
     # numpy.ma (measured 7 ms): paid here, in the first evaluation, not in the first warning after it
