@@ -550,8 +550,9 @@ def run(quick: bool = False) -> str:
                  "exceeds 1e-13 of ω_k (near κ = ±1, where the closed form cancels, and near a root of ω_k) the value comes "
                  "from the coefficient's stable series, generated in the first evaluation for every ω_k that fails the bound "
                  "on the parameter grid; the range of ε is judged from a table of the quiet radius made in the same first "
-                 "evaluation (it accepts |ε| below half the radius, see lindstedt/results/_evaluators.py), and by the orbit's "
-                 "range at κ only where the table cannot tell (here κ ≤ −0.8 and κ ≥ 0.9 at ε = 0.05, or a warning): "
+                 "evaluation (it accepts |ε| below at most half the radius, see lindstedt/results/_evaluators.py), and by the "
+                 "orbit's range at κ only where the table cannot tell (here κ ≤ −0.8 and κ = 0.95 at ε = 0.05, κ = −0.95 "
+                 "a warning): "
                  "those are the slowest calls.\n\n" + "\n".join(lines)
                  + "\n\nTarget (issue 26): median ≤ 5× the lambdified closed form; worst ≤ 5 ms after the first call.\n\n"
                  "**`frequency_coefficients` at a new κ** (the same expansions, at each κ + 2^−30: new again), against the "
