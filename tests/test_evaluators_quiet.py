@@ -1,7 +1,7 @@
 """A symbolic-κ expansion evaluated at parameter values new to it: no warning is lost and no value changes.
 
-The float evaluators decide most calls without computing the orbit's range at the new κ (a table made once per
-expansion, :mod:`lindstedt.results._evaluators`); the reference here is the exact range at each κ
+The float evaluators decide most calls without computing the orbit's range at the new κ (a table of the quiet radius
+made once per expansion); the reference here is the exact range at each κ
 (:meth:`lindstedt.Expansion.epsilon_range`, computed from the orbit at that κ) and, for κ ≤ 0, its closed form: the
 breakpoint κ of (u − κ)₊ becomes the lower turning point of the orbit through u = 1 at ε = −(1 + κ)/(1 − κ)
 (V(κ) = E: κ²/2 = 1/2 + ε (1 − κ)²/2), the nearest singularity of ω(ε).
