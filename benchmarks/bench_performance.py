@@ -245,10 +245,26 @@ def _worker_continuation(spec: dict[str, Any]) -> None:
            "reached": reached, "jumps": len(branch.jumps)})
 
 
+def _worker_cauchy(spec: dict[str, Any]) -> None:
+    """The floor of issue 26 for the piecewise engines: ω_0…ω_N of (u − κ)₊ by the Cauchy integral of the exact
+    closed-form period (``piecewise_linear_frequency_taylor``) at ``precision`` digits, per κ, warm (one untimed call)."""
+    import sympy
+    from lindstedt.references import piecewise_linear_frequency_taylor
+
+    piecewise_linear_frequency_taylor(spec["order"], a=1, b=sympy.Rational(1, 3), a0=1, precision=spec["precision"])
+    times = []
+    for kappa in spec["kappas"]:
+        b = sympy.Rational(kappa)
+        start = time.perf_counter()
+        piecewise_linear_frequency_taylor(spec["order"], a=1, b=b, a0=1, precision=spec["precision"])
+        times.append(time.perf_counter() - start)
+    _emit({"times": times, "median": statistics.median(times), "worst": max(times)})
+
+
 WORKERS = {
     "duffing": _worker_duffing, "expand": _worker_expand, "numeric-kappa": _worker_numeric_kappa,
     "evaluation": _worker_evaluation, "new-kappa": _worker_new_kappa, "nnm": _worker_nnm,
-    "continuation": _worker_continuation,
+    "continuation": _worker_continuation, "cauchy": _worker_cauchy,
 }
 
 
@@ -409,6 +425,13 @@ def run(quick: bool = False) -> str:
     summary.append((f"(u − 3/10)₊ exact, order {last['order']}", _t(last["exact"].get("seconds")), _t(last["float"].get("seconds")) + " (float mode)",
                     f"{last['exact'].get('seconds', math.nan) / last['float'].get('seconds', math.nan):.0f}× float mode",
                     _verdict(last["order"] == 10 and last["exact"].get("seconds", math.inf) <= 10 and accurate) if not quick else "—"))
+    cauchy_10 = _call("cauchy", {"order": last["order"], "precision": 30, "kappas": ["3/10"]}, 300)
+    raw["cauchy_order_10"] = cauchy_10
+    if cauchy_10["status"] == "ok":
+        ratio_cauchy = last["exact"].get("seconds", math.nan) / cauchy_10["median"]
+        summary.append((f"(u − 3/10)₊ exact, order {last['order']}, against the 30-digit Cauchy floor", _t(last["exact"].get("seconds")),
+                        _t(cauchy_10["median"]) + " (Cauchy integral, 30 digits)", f"{ratio_cauchy:.0f}×",
+                        _verdict(ratio_cauchy <= 10) if not quick else "—"))
     parts.append("### 2. Exact contact angles\n\n**(u − 3/10)₊, exact** (`expand(\"Max(0, u - 3/10)\", order=N, a0=1, omega0=1)`; "
                  "floor: the same expansion in float mode, `numeric=True, precision=30`). Reference: "
                  "`piecewise_linear_frequency_taylor` (Cauchy integral of the closed-form period, 45 digits, own estimate).\n\n"
@@ -488,6 +511,14 @@ def run(quick: bool = False) -> str:
     summary.append(("ω1…ω4 at a new κ from the compiled symbolic-κ expansion", _t(compiled_worst[0]), _t(floor_numeric) + " (lambdified closed form)",
                     f"{compiled_worst[0] / floor_numeric:.0f}×; error {_e(compiled_worst[1])}",
                     _verdict(compiled_worst[0] <= 1e-3 and compiled_worst[1] <= 1e-14)))
+    cauchy_4 = {precision: _call("cauchy", {"order": 4, "precision": precision, "kappas": kappas}, 300) for precision in (16, 30)}
+    raw["cauchy_order_4"] = cauchy_4
+    for precision in (16, 30):
+        if precision in worst and cauchy_4[precision]["status"] == "ok":
+            ratio_cauchy = worst[precision][0] / cauchy_4[precision]["worst"]
+            summary.append((f"numeric ω1…ω4 at a new κ (precision={precision}), against the same-digit Cauchy floor",
+                            _t(worst[precision][0]), _t(cauchy_4[precision]["worst"]) + f" (Cauchy integral, {precision} digits)",
+                            f"{ratio_cauchy:.1f}×", _verdict(ratio_cauchy <= 1)))
     if 16 in worst:
         summary.append(("numeric ω1…ω4 at a new κ (precision=16)", _t(worst[16][0]), _t(floor_numeric) + " (compiled closed form)",
                         f"{worst[16][0] / floor_numeric:.0f}× the closed form", _verdict(worst[16][0] <= 1e-3 and worst[16][1] <= 1e-14)))
