@@ -232,3 +232,12 @@ def test_reduced_forced_orbit_in_contact_converges_to_the_full_models():
         errors.append(np.max(np.abs(displacement - full.state[:n])) / np.max(np.abs(full.state[:n])))
     order = -np.polyfit(np.log([4, 8, 16]), np.log(errors), 1)[0]
     assert order > 2 and errors[-1] < 1e-3, (order, errors)
+
+
+def test_unconverged_modes_are_reported_and_warned():
+    # 20 of a 40-mass chain's modes: the Ritz values of the top kept modes converge like (λ_20/λ_31)^2 ≈ 0.3 an
+    # iteration, too slowly for 30 digits within the iterations allowed
+    chain = UnilateralSystem.chain(40, unilateral=[(10, 0)])
+    with pytest.warns(UserWarning, match="not converged to 30 digits"):
+        reduced = ResidualFlexibility(modes=20).reduce((chain.M_exact, chain.K_exact), A=chain.A_exact)
+    assert not reduced.success and "still moving" in reduced.message

@@ -51,6 +51,7 @@ import sympy
 
 from .._budget import Estimate, checkpoint
 from .._errors import ProblemError
+from .._precision import warn_caller
 from .modes import _leading_sign
 from .system import UnilateralSystem
 
@@ -474,7 +475,7 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
         X = to_mpfr(float_modes.shapes)
         MX = product.times(X)
         previous: list[Any] | None = None
-        success, done, solves = False, 0, 0
+        success, done, solves, change = False, 0, 0, math.inf
         tolerance = mpmath.mpf(2) ** (-2 * target)
         with mpmath.workprec(bits):
             while done < _MAX_ITERATIONS:
@@ -490,9 +491,11 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
                 transform = np.array([[_to_mpfr(Q[i, j]) for j in range(columns)] for i in range(columns)], dtype=object)
                 kept = values[:K]
                 X, MX = Y.dot(transform), MY.dot(transform)
-                if previous is not None and all(abs(a - b) <= tolerance * abs(a) for a, b in zip(kept, previous)):
-                    success = True
-                    break
+                if previous is not None:
+                    change = float(max(abs(a - b) / abs(a) for a, b in zip(kept, previous)))
+                    if change <= tolerance:
+                        success = True
+                        break
                 previous = kept
                 checkpoint("subspace iteration", done, _MAX_ITERATIONS)
             # K X by the sparse product: it cancels log2 cond(K) bits, which the working precision holds in reserve
@@ -549,8 +552,11 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
     with mpmath.workdps(method.digits):
         frequencies = tuple(+value for value in frequencies)
     message = (f"{K} modes converged to {method.digits} digits in {done} subspace iterations" if success else
-               f"the Ritz values were still moving after {done} subspace iterations: the kept modes are not converged "
-               f"to {method.digits} digits (keep fewer modes, or more: the convergence rate is (λ_K/λ_q)²)")
+               f"the Ritz values were still moving after {done} subspace iterations (by {change:.1e} relative in the last "
+               f"{steps}): the kept modes are not converged to {method.digits} digits, so a kept mode's ω₀, ω₁ are not the "
+               "full model's to that precision (keep fewer modes, or more: the convergence rate is (λ_K/λ_q)²)")
+    if not success:
+        warn_caller(UserWarning(message))
     return ReducedStructure(system, n, K, frequencies, method.digits, success, message, done, solves, factor.width,
                             projected, basis)
 
