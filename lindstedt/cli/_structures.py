@@ -27,7 +27,6 @@ from .._errors import ProblemError
 __all__ = ["reduced_structure"]
 
 _MODEL_KEYS = ("matrices", "elements")
-_ELEMENT_KEYS = ("law", "a", "b", "w")
 
 
 def _row(value: Any, n: int, what: str) -> dict[int, sympy.Expr]:
@@ -67,7 +66,7 @@ def reduced_structure(data: Mapping[str, Any], path: str, modes: int, digits: in
     """
     from ..problems.reduction import ResidualFlexibility
     from ..problems.structures import read_matrices
-    from ..problems.system import UnilateralSystem
+    from ..problems.system import _ELEMENT_KEYS, UnilateralSystem
 
     method = ResidualFlexibility(modes=modes, digits=digits)
     if "matrices" not in data:

@@ -146,7 +146,7 @@ class _BandedLDL:
         order = np.asarray(reverse_cuthill_mckee(pattern, symmetric_mode=True), dtype=np.int64)
         position = np.empty(n, dtype=np.int64)
         position[order] = np.arange(n)
-        self.order, self.position, self.n = order, position, n
+        self.order, self.n = order, n
         rows: list[dict[int, Any]] = [{} for _ in range(n)]
         width = 0
         for (i, j), value in entries.items():
@@ -180,32 +180,28 @@ class _BandedLDL:
                                    "structure is a mechanism; fix its supports")
             diagonal.append(total)
             lower.append(entries_i)
-        self.lower, self.diagonal = lower, diagonal
-        self._rows: list[tuple[int, np.ndarray]] | None = None
+        # the band of L by rows (forward sweep) and by columns (Lᵀ sweep) as small object arrays: one dot per row
+        self._rows: list[tuple[int, np.ndarray]] = []
+        by_column: list[list[tuple[int, Any]]] = [[] for _ in range(n)]
+        for i, entries in enumerate(lower):
+            start = entries[0][0] if entries else i
+            coefficients = [zero] * (i - start)
+            for j, l_ij in entries:
+                coefficients[j - start] = l_ij
+                by_column[j].append((i, l_ij))
+            self._rows.append((start, np.array(coefficients, dtype=object)))
+        self._columns: list[tuple[int, np.ndarray]] = []
+        for j, entries in enumerate(by_column):
+            stop = entries[-1][0] + 1 if entries else j + 1
+            coefficients = [zero] * (stop - j - 1)
+            for i, l_ij in entries:
+                coefficients[i - j - 1] = l_ij
+            self._columns.append((stop, np.array(coefficients, dtype=object)))
+        self._diagonal = np.array(diagonal, dtype=object)[:, None]
 
     def solve(self, columns: np.ndarray) -> np.ndarray:
         """``S⁻¹ columns`` for an (n, c) object array of mpfr (one small dot per row and sweep: the band's entries
         of a row, or of a column of L, against the rows of the right-hand side they meet)."""
-        if self._rows is None:
-            zero = _gmpy2().mpfr(0)
-            band_rows, band_columns = [], [[] for _ in range(self.n)]
-            for i, entries in enumerate(self.lower):
-                start = entries[0][0] if entries else i
-                coefficients = [zero] * (i - start)
-                for j, l_ij in entries:
-                    coefficients[j - start] = l_ij
-                band_rows.append((start, np.array(coefficients, dtype=object)))
-                for j, l_ij in entries:
-                    band_columns[j].append((i, l_ij))
-            self._rows = band_rows
-            self._columns = []
-            for j, entries in enumerate(band_columns):
-                stop = entries[-1][0] + 1 if entries else j + 1
-                coefficients = [zero] * (stop - j - 1)
-                for i, l_ij in entries:
-                    coefficients[i - j - 1] = l_ij
-                self._columns.append((stop, np.array(coefficients, dtype=object)))
-            self._diagonal = np.array(self.diagonal, dtype=object)[:, None]
         y = columns[self.order].copy()
         for i, (start, coefficients) in enumerate(self._rows):
             if start < i:
@@ -246,6 +242,15 @@ class _SparseProduct:
         for rows, sources, values in self.diagonals:
             result[rows] += values * columns[sources]  # one entry per row on a diagonal
         return result
+
+
+def _dense(entries: dict[tuple[int, int], Any], shape: tuple[int, int], transposed: bool = False) -> np.ndarray:
+    """An (object) mpfr array of ``shape`` holding sparse exact ``entries`` ``(i, j) -> value`` (at ``(j, i)`` if
+    ``transposed``), zeros elsewhere."""
+    array = np.full(shape, _gmpy2().mpfr(0), dtype=object)
+    for (i, j), value in entries.items():
+        array[(j, i) if transposed else (i, j)] = _mpfr(value)
+    return array
 
 
 def _to_mpmath(value: Any) -> Any:
@@ -504,17 +509,8 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
             # each mode signed as the full model's modes are (its first entry of largest magnitude positive)
             signs = np.array([_leading_sign([float(v) for v in X[:, k]]) for k in range(K)], dtype=object)
             X, KX, MX = X * signs, KX * signs, MX * signs
-            W = np.zeros((n, m), dtype=object) + gmpy2.mpfr(0)
-            if forces is None:
-                for (i, j), value in elements.items():
-                    W[j, i] = _mpfr(value)
-            else:
-                for (i, j), value in forces.items():
-                    W[i, j] = _mpfr(value)
-            P = np.zeros((n, len(loads)), dtype=object) + gmpy2.mpfr(0)
-            for column, load in enumerate(loads):
-                for i, value in load.items():
-                    P[i, column] = _mpfr(value)
+            W = _dense(elements, (n, m), transposed=True) if forces is None else _dense(forces, (n, m))
+            P = _dense({(i, column): value for column, load in enumerate(loads) for i, value in load.items()}, (n, len(loads)))
             statics = np.hstack((W, P))
             Z = factor.solve(statics)  # K Z = [W, P]
             solves += statics.shape[1]
@@ -532,10 +528,7 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
             V, KV, MV = (np.hstack(pair) for pair in ((X, Z), (KX, KZ), (MX, MZ)))
             reduced_mass = V.T.dot(MV)
             reduced_stiffness = V.T.dot(KV)
-            A = np.zeros((m, n), dtype=object) + gmpy2.mpfr(0)
-            for (i, j), value in elements.items():
-                A[i, j] = _mpfr(value)
-            reduced_A = A.dot(V)
+            reduced_A = _dense(elements, (m, n)).dot(V)
             reduced_W = V.T.dot(W)
             reduced_loads = V.T.dot(P)
             basis = V.astype(float)
