@@ -32,6 +32,11 @@ Conservative oscillator ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0``, ``u'(0) 
     references read a number (exact inputs rounded once, at the mpmath
     precision in effect).
 
+Polynomial oscillator ``u'' + ω0² u + ε f(u) = 0``, ``u(0) = a0``, ``u'(0) = 0`` (f with rational coefficients)
+    :func:`conservative_frequency_series` — the exact rational Taylor coefficients of
+    ``ω(ε)`` from the energy integral: the ε series of ``T = ∮ du/√(2(E − V))`` integrated
+    term by term around the turning points (Beta functions continued to ``−k − 1/2``).
+
 Nonlinear normal modes of ``M X'' + K X + ε W (A X − b)_+ = 0``
     :func:`release_amplitudes_by_series` — the release amplitudes ``a_k``
     (k ≠ j) of mode j at first order as Fourier series of the contact functions,
@@ -59,6 +64,7 @@ from .piecewise import (
 )
 from .arguments import as_mpmath_number
 from .chebyshev import frequency_taylor_coefficients
+from .energy_series import conservative_frequency_series
 from .quadrature import conservative_frequency, conservative_period, nonlinearity_breakpoints
 
 __all__ = [
@@ -71,6 +77,7 @@ __all__ = [
     "conservative_period",
     "conservative_frequency",
     "frequency_taylor_coefficients",
+    "conservative_frequency_series",
     "nonlinearity_breakpoints",
     "as_mpmath_number",
     "release_amplitudes_by_series",
