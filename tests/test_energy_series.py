@@ -63,6 +63,7 @@ CASES = [
     ("u**4 - u/3", 1, "sqrt(2)", 10),
     ("-u**3", "1/3", 1, 16),  # softening
     ("u**3", 1, 1, 40),
+    ("u**2 + u**3", 1, 1, 60),  # an asymmetric orbit at high order: 60 exact rationals of ~300 digits each
 ]
 
 
