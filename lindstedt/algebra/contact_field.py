@@ -399,10 +399,11 @@ class ContactField:
             if common:
                 terms = {key - common: value for key, value in terms.items()}
                 monomial -= common
-        divisor = gcd(scale, *terms.values())
-        if divisor != 1:
-            terms = {key: value // divisor for key, value in terms.items()}
-            scale //= divisor
+        if scale != 1:
+            divisor = gcd(scale, *terms.values())
+            if divisor != 1:
+                terms = {key: value // divisor for key, value in terms.items()}
+                scale //= divisor
         return ContactElement(self, terms, scale, monomial)
 
     def _rational(self, value: Any) -> "ContactElement":
@@ -423,7 +424,8 @@ class ContactField:
         """
         if len(first) < len(second):
             first, second = second, first
-        reduced, guards = self._singles, self._guards
+        guards = self._guards
+        reduced = self._singles | guards  # a group with a guard bit: an exponent ≥ 2^(W − 1), the sums would carry
         groups: dict = {}
         for key, value in first.items():
             part = key & reduced
@@ -438,7 +440,7 @@ class ContactField:
                 other_groups[part].append((key, value))
             else:
                 other_groups[part] = [(key, value)]
-        if any(key & guards for key in first) or any(key & guards for key in second):  # sums would carry
+        if any(part & guards for part in groups) or any(part & guards for part in other_groups):
             raise OverflowError(f"a power above {_LIMIT - 1} in the contact field")
         terms: dict = {}
         squares = self._squares
@@ -576,7 +578,8 @@ class ContactElement:
         return self
 
     def __add__(self, other: Any) -> "ContactElement":
-        other = self._coerce(other)
+        if other.__class__ is not ContactElement:
+            other = self.field.convert(other)
         field = self.field
         if not other.terms:
             return self
@@ -627,7 +630,8 @@ class ContactElement:
         return self._coerce(other) + (-self)
 
     def __mul__(self, other: Any) -> "ContactElement":
-        other = self._coerce(other)
+        if other.__class__ is not ContactElement:
+            other = self.field.convert(other)
         field = self.field
         if not self.terms or not other.terms:
             return field.zero
@@ -654,7 +658,8 @@ class ContactElement:
     __rmul__ = __mul__
 
     def __truediv__(self, other: Any) -> "ContactElement":
-        other = self._coerce(other)
+        if other.__class__ is not ContactElement:
+            other = self.field.convert(other)
         if other.monomial == 0 and len(other.terms) == 1 and 0 in other.terms:  # a rational divisor
             value = other.terms[0]
             return self * ContactElement(self.field, {0: other.scale if value > 0 else -other.scale}, abs(value), 0)

@@ -191,6 +191,7 @@ class BranchHierarchy(LazyOrders):
         ]
         self._lag = int(any(boundary.grazing for boundary in system.boundaries))
         self._derivatives: dict[tuple[int, int, int, int], Branch] = {}
+        self._power_tables: list[tuple | None] = [None] * len(system.boundaries)  # per boundary: the last shift_powers
         self._law_powers: dict[tuple, Branch] = {}
         # per stretched arc (first, last piece): its length ℓ_n (ℓ = s_1* or π − s_L*), μ_n = [Ω²/ℓ²]_n and
         # per component Q_{n,k} = [Y_k'(1)/ℓ]_n, the slope it hands to its neighbour (Q_{0,j} = −sin β)
@@ -332,7 +333,12 @@ class BranchHierarchy(LazyOrders):
 
     def _shift_powers(self, boundary: int, order: int) -> list[list[Any]]:
         """[δσ^n]_j for n, j <= order, δσ = Σ_i σ_i η^i over the σ_i known before order ``order``."""
-        return shift_powers(self._shifts[boundary][:order], order, self._domain)
+        shifts = self._shifts[boundary][:order]
+        cached = self._power_tables[boundary]  # ((order, len(shifts)), table): asked twice per order, extended by a column
+        if cached is None or cached[0] != (order, len(shifts)):
+            previous = None if cached is None else (cached[0][1], cached[1])
+            cached = self._power_tables[boundary] = ((order, len(shifts)), shift_powers(shifts, order, self._domain, previous))
+        return cached[1]
 
     def _known(self, boundary: int, piece: int, component: int, order: int, derivative: int, powers: list[list[Any]]) -> Any:
         """ε̂^order coefficient of ∂^derivative W_component^piece at s*(ε̂), without W_order and σ_order."""

@@ -36,21 +36,34 @@ def extend_square_root(roots: list[Any], squared: Callable[[int], Any], order: i
     return roots[order]
 
 
-def shift_powers(shifts: list[Any], order: int, domain: Any) -> list[list[Any]]:
+def shift_powers(shifts: list[Any], order: int, domain: Any, previous: tuple[int, list[list[Any]]] | None = None) -> list[list[Any]]:
     """``[δσ^n]_j`` for n, j ≤ order, where ``shifts[i] = σ_i`` (``shifts[0]`` ignored, missing ones zero).
+
+    ``previous = (len(earlier), table)``: the table of an earlier call whose ``earlier`` is a prefix of
+    ``shifts``; its entries involving only shifts known to both calls (``[δσ^n]_j`` needs σ_i, i ≤ j − n + 1)
+    are reused, so the hierarchy's table at order N + 1 costs the new column only: O(N²) products, not
+    O(N³) (κ = 3/10 to order 10: 495 -> ~130 products of field elements).
 
     Examples
     --------
     >>> from sympy import QQ
     >>> [str(c) for c in shift_powers([QQ(0), QQ(2)], 2, QQ)[2]]     # (2ε)² = 4ε²
     ['0', '0', '4']
+    >>> [str(c) for c in shift_powers([QQ(0), QQ(2), QQ(3)], 3, QQ, (2, shift_powers([QQ(0), QQ(2)], 2, QQ)))[2]]
+    ['0', '0', '4', '12']
     """
     zero = domain.zero
     padded = [zero] + [shifts[i] if i < len(shifts) else zero for i in range(1, order + 1)]
+    known = min(len(shifts), order + 1)
     powers = [[domain.one] + [zero] * order]
-    for _ in range(order):
-        previous = powers[-1]
-        powers.append([sum((previous[j - i] * padded[i] for i in range(1, j + 1)), zero) for j in range(order + 1)])
+    for power in range(1, order + 1):
+        last = powers[-1]
+        row: list[Any] = []
+        if previous is not None and power < len(previous[1]):
+            earlier = previous[1][power]
+            row = earlier[:max(0, min(order, len(earlier) - 1, min(previous[0], known) + power - 2) + 1)]
+        row += [sum((last[j - i] * padded[i] for i in range(1, j + 1)), zero) for j in range(len(row), order + 1)]
+        powers.append(row)
     return powers
 
 
