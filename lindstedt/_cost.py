@@ -181,6 +181,10 @@ def expansion_features(problem: Any, order: int, precision: int, numeric: bool) 
     )
 
 
+#: f → its text in an estimate's task (see :func:`_short`)
+_LAW_TEXT: dict[Any, str] = {}
+
+
 def expansion_estimate(problem: Any, order: int, precision: int, numeric: bool) -> Estimate:
     """The :class:`~lindstedt.limits.Estimate` of an expansion request (see the module docstring)."""
     features = expansion_features(problem, order, precision, numeric)
@@ -189,8 +193,11 @@ def expansion_estimate(problem: Any, order: int, precision: int, numeric: bool) 
     memory = max(1.0, scale * seconds**power * max(features.breakpoints, 1) ** per_breakpoint
                  * (features.digits / 30) ** per_digit)
     advice = _advice(problem, features, precision)
-    law = str(problem.f)
-    law = law if len(law) <= 60 else law[:57] + "..."
+    law = _LAW_TEXT.get(problem.f)
+    if law is None:  # printing f costs more than the rest of the estimate: once per f (its parameters symbolic)
+        if len(_LAW_TEXT) >= 256:
+            _LAW_TEXT.pop(next(iter(_LAW_TEXT)))
+        law = _LAW_TEXT[problem.f] = _short(problem.f)
     vector = features.vector()
     return Estimate(task=f"expansion of {law} to order {order}", seconds=seconds, memory_mb=memory,
                     drivers=features.drivers(), advice=advice,

@@ -36,8 +36,8 @@ import sympy
 from sympy import QQ, RealField
 from sympy.polys.polyerrors import CoercionFailed
 
-from .._errors import ProblemError, UnsupportedNonlinearityError
-from ..problems.piecewise_linear import decompose_piecewise
+from .._errors import LindstedtError, ProblemError, UnsupportedNonlinearityError
+from ..problems.piecewise_linear import PolynomialInterval, decompose_piecewise
 from ..problems.oscillator import DISPLACEMENT, Oscillator
 from ..algebra.branch import EvaluationPoint
 from ..algebra.contact_field import ContactField
@@ -118,7 +118,7 @@ class _ConstantField:
         self.contact_field: ContactField | None = None
         if self.numeric:
             self.digits = digits or 30
-            self.domain = RealField(dps=self.digits)
+            self.domain = _real_field(self.digits)
             return
         self.digits = None
         try:
@@ -180,7 +180,10 @@ def _sign_of_amplitude(amplitude: sympy.Expr) -> int:
 
 def _compare(value: sympy.Expr, bound: int) -> int | None:
     """Sign of value - bound when decidable, else None."""
-    difference = sympy.simplify(value - bound)
+    difference = value - bound
+    if difference.is_Rational:  # decided: no simplification to try
+        return (difference.p > 0) - (difference.p < 0)
+    difference = sympy.simplify(difference)
     if difference.is_zero:
         return 0
     if difference.is_positive:
@@ -190,11 +193,23 @@ def _compare(value: sympy.Expr, bound: int) -> int | None:
     return None
 
 
-def _contact_sine(kappa: sympy.Expr) -> sympy.Expr:
-    """sin β = sqrt(1 − κ²), without sympy's perfect-power search for rationals with huge denominators."""
-    if kappa.is_Rational and kappa.q > 10**12:
+def _contact_sine(kappa: sympy.Expr, numeric: bool = False) -> sympy.Expr:
+    """sin β = sqrt(1 − κ²), without sympy's perfect-power search for rationals with huge denominators, nor for
+    a float hierarchy (which only evaluates it)."""
+    if kappa.is_Rational and (numeric or kappa.q > 10**12):
         return sympy.Pow(1 - kappa**2, sympy.Rational(1, 2), evaluate=False)
     return sympy.sqrt(1 - kappa**2)
+
+
+_REAL_FIELDS: dict[int, Any] = {}
+
+
+def _real_field(digits: int) -> Any:
+    """``RealField(dps=digits)``, made once per digits (each makes its own mpmath context, ~0.5 ms)."""
+    field = _REAL_FIELDS.get(digits)
+    if field is None:
+        field = _REAL_FIELDS[digits] = RealField(dps=digits)
+    return field
 
 
 def _guard_digits(kappas: list[sympy.Expr], order: int) -> int:
@@ -209,11 +224,49 @@ def _guard_digits(kappas: list[sympy.Expr], order: int) -> int:
         for kappa in kappas:
             if not kappa.is_number:
                 continue
-            angle = mpmath.acos(mpmath.mpf(sympy.N(kappa, 60)))
+            angle = mpmath.acos(mpmath.mpf(kappa.p) / kappa.q if kappa.is_Rational else mpmath.mpf(sympy.N(kappa, 60)))
             margin = min(margin, angle, mpmath.pi - angle)
         if margin <= 0:
             return 0
         return int(mpmath.ceil((2 * order + 5) * max(0, -mpmath.log10(margin))))
+
+
+#: f with its parameters symbolic → its polynomial intervals (None: not decomposable so, or not polynomial on every
+#: piece); read by :func:`_intervals` for every numeric value of the parameters
+_SYMBOLIC_INTERVALS: dict[sympy.Expr, list[PolynomialInterval] | None] = {}
+
+
+def _intervals(problem: Oscillator) -> list[PolynomialInterval]:
+    """``decompose_piecewise(problem.nonlinearity)``: for rational parameter values, the decomposition of f with its
+    parameters symbolic (made once per f) with the values put in, when that decomposition exists and every piece is
+    polynomial — the breakpoints it orders and the signs it decides hold for every real value, so it is the same
+    (trailing zero coefficients above degree 1 dropped, as the direct decomposition has none)."""
+    values = {symbol: value for symbol, value in problem.params if value != symbol}
+    if values and all(isinstance(value, sympy.Rational) for value in values.values()):
+        if problem.f not in _SYMBOLIC_INTERVALS:
+            try:
+                symbolic = decompose_piecewise(problem.f, DISPLACEMENT)
+            except LindstedtError:  # e.g. two symbolic gaps that only numbers order
+                symbolic = None
+            if symbolic is not None and any(interval.fractional or interval.analytic != 0 for interval in symbolic):
+                symbolic = None
+            if len(_SYMBOLIC_INTERVALS) >= 64:
+                _SYMBOLIC_INTERVALS.pop(next(iter(_SYMBOLIC_INTERVALS)))
+            _SYMBOLIC_INTERVALS[problem.f] = symbolic
+        symbolic = _SYMBOLIC_INTERVALS[problem.f]
+        intervals = []
+        for interval in symbolic or ():
+            lower, upper = (None if end is None else end.xreplace(values) for end in (interval.lower, interval.upper))
+            coefficients = [coefficient.xreplace(values) for coefficient in interval.coefficients]
+            while len(coefficients) > 2 and coefficients[-1] == 0:
+                coefficients.pop()
+            if not all(isinstance(value, sympy.Rational) for value in [lower, upper, *coefficients] if value is not None):
+                break
+            intervals.append(PolynomialInterval(lower, upper, tuple(coefficients)))
+        else:
+            if symbolic:
+                return intervals
+    return decompose_piecewise(problem.nonlinearity, DISPLACEMENT)
 
 
 @locked
@@ -225,7 +278,7 @@ def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hi
     numeric case guard digits are added near grazing (see :func:`_guard_digits`)
     so that ``digits`` stay correct up to order ``order_hint``.
     """
-    intervals = decompose_piecewise(problem.nonlinearity, DISPLACEMENT)
+    intervals = _intervals(problem)
     amplitude = problem.a0
     sign = _sign_of_amplitude(amplitude)
     # w-breakpoints κ_i = u_i / a0, and the law f̂(w) = f(a0 w)/a0 = Σ_m c_m a0^{m−1} w^m on each interval.
@@ -400,16 +453,14 @@ def _assemble(
     top = [item for item in crossed if item[0] > 0]
     bottom = [item for item in crossed if item[0] < 0]
     interval_of = [item[1] for item in top] + list(interval_of) + [item[1] for item in bottom]
-    values: list[sympy.Expr] = []
-    for interval_index in interval_of:
-        values += list(w_intervals[interval_index][2])
-    for kappa in crossing_kappas:
-        values += [kappa, sympy.acos(kappa), _contact_sine(kappa)]
-    values += [item[2] for item in crossed]
+    laws = [value for interval_index in interval_of for value in w_intervals[interval_index][2]]
     # u(0) = a0 (1 + Σ ε̂^n W_n(0)), ε̂ = ε/ω0²
     releases = [shift * problem.omega0 ** (2 * n) / problem.a0 for n, shift in enumerate(problem.release_shifts, 1)]
-    values += releases
-    numeric = digits is not None or any(value.has(sympy.Float) for value in values)
+    shifts = [item[2] for item in crossed]
+    # arccos κ and sin β hold a float exactly when κ does; a float field needs none of them
+    numeric = digits is not None or any(value.has(sympy.Float) for value in laws + crossing_kappas + shifts + releases)
+    angles = [] if numeric else [value for kappa in crossing_kappas for value in (kappa, sympy.acos(kappa), _contact_sine(kappa))]
+    values = laws + angles + shifts + releases
     if numeric:
         digits = (digits or 30) + _guard_digits(crossing_kappas, order_hint)
         # a nonlinear polynomial law loses about half a digit per order to cancellation in the branch products
@@ -429,7 +480,7 @@ def _assemble(
     for kappa in sorted(crossing_kappas, key=lambda k: -k if k.is_number else 0):
         angle = sympy.acos(kappa)
         kappa_element = field.convert(kappa)
-        sine_element = field.convert(_contact_sine(kappa))
+        sine_element = field.convert(_contact_sine(kappa, field.numeric))
         point = EvaluationPoint(domain, field.convert(angle), kappa_element, sine_element)
         boundaries.append(ContactBoundary(kappa, angle, point, kappa_element, sine_element))
         moving.append(MovingBoundary(point, (domain.one,), sine_element))

@@ -67,6 +67,48 @@ RESERVED_NAMES = frozenset({"u", "s", "t", "w", "epsilon", "a0", "omega0"}) | fr
 DEFAULT_RELEASE_ORDER = 4
 
 
+def _undecidable(arguments: Sequence[sympy.Expr]) -> bool:
+    """True when no two of ``arguments`` can be ordered for every u: each pairwise difference is r·u + c with r a
+    nonzero rational and c free of u and finite (u real and unbounded, so its sign changes with u), and none is
+    itself a switch.  ``Max``/``Min`` of such arguments keeps every one of them: sympy's evaluation
+    (``_collapse_arguments``, ``_find_localzeros``, which decide the pairwise orderings through the assumptions
+    system, milliseconds per call) cannot remove any, and ``evaluate=False`` builds the same object."""
+    if any(argument.has(sympy.Max, sympy.Min, sympy.Piecewise, sympy.oo, -sympy.oo, sympy.zoo, sympy.nan)
+           for argument in arguments):
+        return False
+    for index, first in enumerate(arguments):
+        for second in arguments[index + 1:]:
+            constant, linear = (first - second).as_independent(DISPLACEMENT, as_Add=True)
+            factor, rest = linear.as_coeff_Mul()
+            if rest != DISPLACEMENT or not factor.is_Rational or factor == 0 or constant.is_extended_real is not True:
+                return False
+    return True
+
+
+def substitute(expression: sympy.Expr, values: Mapping[sympy.Symbol, sympy.Expr]) -> sympy.Expr:
+    """``expression.subs(values)`` for numbers given to parameter symbols, the same object, without re-deciding the
+    orderings of a ``Max``/``Min`` whose arguments stay undecidable (:func:`_undecidable`): such a switch is rebuilt
+    with ``evaluate=False``; every other node as ``subs`` builds it.
+
+    Examples
+    --------
+    >>> kappa = sympy.Symbol("kappa", real=True)
+    >>> f = sympy.Max(0, DISPLACEMENT - kappa) + kappa * DISPLACEMENT**3
+    >>> substitute(f, {kappa: sympy.Rational(3, 10)}) == f.subs(kappa, sympy.Rational(3, 10))
+    True
+    """
+    if not values or not expression.free_symbols & set(values):
+        return expression
+    if isinstance(expression, (sympy.Max, sympy.Min)):
+        arguments = [substitute(argument, values) for argument in expression.args]
+        if _undecidable(arguments):
+            return expression.func(*arguments, evaluate=False)
+        return expression.func(*arguments)
+    if isinstance(expression, (sympy.Add, sympy.Mul, sympy.Pow)):
+        return expression.func(*[substitute(argument, values) for argument in expression.args])
+    return expression.subs(values)
+
+
 #: the largest (u0·ω0)² + v0² taken: a finite float (sympy extracts the square root of it through a float)
 _LARGEST_SQUARE = sympy.Rational(*sys.float_info.max.as_integer_ratio())
 
@@ -506,8 +548,12 @@ class Oscillator:
     # -- derived views ---------------------------------------------------------------------
     @property
     def nonlinearity(self) -> sympy.Expr:
-        """f(u) with the numeric parameter values substituted (symbolic ones kept)."""
-        return self.f.subs({symbol: value for symbol, value in self.params if value != symbol})
+        """f(u) with the numeric parameter values substituted (symbolic ones kept); made once per problem."""
+        cached = self.__dict__.get("_nonlinearity")
+        if cached is None:
+            cached = substitute(self.f, {symbol: value for symbol, value in self.params if value != symbol})
+            object.__setattr__(self, "_nonlinearity", cached)
+        return cached
 
     @property
     def parameter_values(self) -> dict[sympy.Symbol, sympy.Expr]:

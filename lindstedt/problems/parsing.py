@@ -424,6 +424,12 @@ class _Builder:
             raise self.fail(f"Piecewise{tuple(pieces)} cannot be formed ({error})") from None
 
 
+#: Texts already read (text, what, the names given, the bounds) → their expression: the same text is read once (its
+#: sympy evaluation, e.g. of a ``Max``, costs milliseconds); only texts that passed every check are kept.
+_PARSED: dict[tuple[Any, ...], sympy.Basic] = {}
+_PARSED_SIZE = 256
+
+
 @locked
 def parse_expression(
     text: str | sympy.Expr | int | float,
@@ -476,7 +482,13 @@ def parse_expression(
                 _check_real(part, what, str(text))
             _check_degree(expression, what, str(text), {})
     else:
-        expression = _parse_text(text, symbols, what)
+        key = (text, what, tuple(symbols.items()), LIMITS)
+        expression = _PARSED.get(key)
+        if expression is None:
+            expression = _parse_text(text, symbols, what)
+            if len(_PARSED) >= _PARSED_SIZE:
+                _PARSED.pop(next(iter(_PARSED)))
+            _PARSED[key] = expression
     if not isinstance(expression, sympy.Expr):
         raise ProblemError(f"{what} = {text!r} is not a mathematical expression")
     if expression.has(sympy.zoo, sympy.oo, -sympy.oo, sympy.nan):
