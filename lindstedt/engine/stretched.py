@@ -227,9 +227,13 @@ class VectorArc:
 
     # -- the law on the arc -----------------------------------------------------------------------------
     def _projection(self, vector: Sequence[Any], order: int) -> list[Any]:
-        """vector · Y_order at the nodes."""
-        values = self._values[order]
-        return [mpmath.fsum(w * values[k][i] for k, w in enumerate(vector) if w) for i in range(self.nodes)]
+        """vector · Y_order at the nodes (memoised per vector and order: every component's law reads the same
+        projections — recomputing them per component made the N-dof arc O(N²) per order)."""
+        key = ("projection", id(vector), order)
+        if key not in self._powers:
+            values = self._values[order]
+            self._powers[key] = [mpmath.fsum(w * values[k][i] for k, w in enumerate(vector) if w) for i in range(self.nodes)]
+        return self._powers[key]
 
     def _power(self, element: int, power: int, order: int) -> list[Any]:
         """[(c_e · Y)^power]_order at the nodes."""
