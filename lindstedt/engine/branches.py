@@ -58,7 +58,7 @@ from typing import Any, Sequence
 
 from ..algebra.branch import Branch, EvaluationPoint
 from .._precision import locked
-from .orders import LazyOrders, shift_powers
+from .orders import LazyOrders, shift_powers, sum_of_products
 from .affine import _Affine, solve_linear
 from .float_branches import FloatBranches
 from .stretched import VectorArc
@@ -344,7 +344,7 @@ class BranchHierarchy(LazyOrders):
         """ε̂^order coefficient of ∂^derivative W_component^piece at s*(ε̂), without W_order and σ_order."""
         point = self.system.boundaries[boundary].point
         domain = self._domain
-        total = domain.zero
+        terms = []
         factorial = 1
         for times in range(1, order + 1):
             factorial *= times
@@ -352,8 +352,8 @@ class BranchHierarchy(LazyOrders):
             for j in range(0, order - times + 1):
                 weight = powers[times][order - j]
                 if weight:
-                    total = total + self._derivative(j, piece, component, times + derivative).evaluate(point) * weight * inverse
-        return total
+                    terms.append((self._derivative(j, piece, component, times + derivative).evaluate(point), weight, inverse))
+        return sum_of_products(domain, terms)
 
     def _boundary_first_harmonic(self, boundary: int, order: int, powers: list[list[Any]]) -> Any:
         """ε̂^order coefficient of ∫_β^{s*} (W_j^p − W_j^{p+1}) cos s ds (known part)."""

@@ -13,7 +13,7 @@ from sympy import Rational
 from .._precision import locked
 from ..limits import checkpoint
 
-__all__ = ["LazyOrders", "extend_square_root", "shift_powers"]
+__all__ = ["LazyOrders", "extend_square_root", "shift_powers", "sum_of_products"]
 
 
 def extend_square_root(roots: list[Any], squared: Callable[[int], Any], order: int, domain: Any) -> Any:
@@ -65,6 +65,25 @@ def shift_powers(shifts: list[Any], order: int, domain: Any, previous: tuple[int
         row += [sum((last[j - i] * padded[i] for i in range(1, j + 1)), zero) for j in range(len(row), order + 1)]
         powers.append(row)
     return powers
+
+
+def sum_of_products(domain: Any, triples: list[tuple[Any, Any, Any]]) -> Any:
+    """``Σ a · b · c`` over ``triples``, added in their order; a domain with its own ``sum_of_products``
+    (:class:`~lindstedt.algebra.contact_field.ContactField`: one accumulation, normalized once) uses it.
+
+    Examples
+    --------
+    >>> from sympy import QQ
+    >>> print(sum_of_products(QQ, [(QQ(1), QQ(2), QQ(3)), (QQ(1, 2), QQ(1, 3), QQ(6))]))
+    7
+    """
+    fused = getattr(domain, "sum_of_products", None)
+    if fused is not None:
+        return fused(triples)
+    total = domain.zero
+    for a, b, c in triples:
+        total = total + a * b * c
+    return total
 
 
 class LazyOrders:
