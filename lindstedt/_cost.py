@@ -196,7 +196,7 @@ def expansion_estimate(problem: Any, order: int, precision: int, numeric: bool) 
     law = _LAW_TEXT.get(problem.f)
     if law is None:  # printing f costs more than the rest of the estimate: once per f (its parameters symbolic)
         if len(_LAW_TEXT) >= 256:
-            _LAW_TEXT.pop(next(iter(_LAW_TEXT)))
+            _LAW_TEXT.clear()
         law = _LAW_TEXT[problem.f] = _short(problem.f)
     vector = features.vector()
     return Estimate(task=f"expansion of {law} to order {order}", seconds=seconds, memory_mb=memory,

@@ -424,8 +424,9 @@ class _Builder:
             raise self.fail(f"Piecewise{tuple(pieces)} cannot be formed ({error})") from None
 
 
-#: Texts already read (text, what, the names given, the bounds) → their expression: the same text is read once (its
-#: sympy evaluation, e.g. of a ``Max``, costs milliseconds); only texts that passed every check are kept.
+#: Texts already read (the text, what it is called, the bounds, and what each name of its syntax tree stands for) →
+#: their expression: the same text is built once (its sympy evaluation, e.g. of a ``Max``, costs milliseconds); only
+#: texts that passed every check are kept.
 _PARSED: dict[tuple[Any, ...], sympy.Basic] = {}
 _PARSED_SIZE = 256
 
@@ -482,13 +483,7 @@ def parse_expression(
                 _check_real(part, what, str(text))
             _check_degree(expression, what, str(text), {})
     else:
-        key = (text, what, tuple(symbols.items()), LIMITS)
-        expression = _PARSED.get(key)
-        if expression is None:
-            expression = _parse_text(text, symbols, what)
-            if len(_PARSED) >= _PARSED_SIZE:
-                _PARSED.pop(next(iter(_PARSED)))
-            _PARSED[key] = expression
+        expression = _parse_text(text, symbols, what)
     if not isinstance(expression, sympy.Expr):
         raise ProblemError(f"{what} = {text!r} is not a mathematical expression")
     if expression.has(sympy.zoo, sympy.oo, -sympy.oo, sympy.nan):
@@ -510,10 +505,19 @@ def _parse_text(text: str, symbols: Mapping[str, sympy.Expr], what: str) -> symp
     count = sum(1 for _ in ast.walk(tree))
     if count > LIMITS.nodes:
         raise ProblemError(f"{what} has {count} syntax nodes, more than the bound of {LIMITS.nodes}; simplify it")
+    names = sorted({node.id for node in ast.walk(tree) if isinstance(node, ast.Name)})
+    key = (source, what, LIMITS, tuple((name, symbols.get(name)) for name in names))
+    expression = _PARSED.get(key)
+    if expression is not None:
+        return expression
     try:
-        return _Builder(source, symbols, what).build(tree)
+        expression = _Builder(source, symbols, what).build(tree)
     except RecursionError:  # pragma: no cover - the depth bound comes first
         raise ProblemError(f"{what} is nested too deeply; simplify it") from None
+    if len(_PARSED) >= _PARSED_SIZE:
+        _PARSED.clear()
+    _PARSED[key] = expression
+    return expression
 
 
 def as_exact(value: Any, *, what: str) -> sympy.Expr:
