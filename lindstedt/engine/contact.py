@@ -251,7 +251,7 @@ def _intervals(problem: Oscillator) -> list[PolynomialInterval]:
             if symbolic is not None and any(interval.fractional or interval.analytic != 0 for interval in symbolic):
                 symbolic = None
             if len(_SYMBOLIC_INTERVALS) >= 64:
-                _SYMBOLIC_INTERVALS.pop(next(iter(_SYMBOLIC_INTERVALS)))
+                _SYMBOLIC_INTERVALS.clear()
             _SYMBOLIC_INTERVALS[problem.f] = symbolic
         symbolic = _SYMBOLIC_INTERVALS[problem.f]
         intervals = []
