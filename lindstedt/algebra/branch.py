@@ -33,6 +33,7 @@ import sympy
 from sympy import QQ
 
 from .._precision import LOCK
+from .contact_field import sum_of_products
 
 __all__ = ["Branch", "EvaluationPoint"]
 
@@ -389,11 +390,12 @@ class Branch:
         cached = self._values.get(point)
         if cached is not None:
             return cached
-        total = self.domain.zero
+        triples = []
         for (harmonic, parity, power), value in self.terms.items():
             trig = point.cos_multiple(harmonic) if parity == 0 else point.sin_multiple(harmonic)
             if trig:
-                total = total + value * point.power(power) * trig
+                triples.append((value, point.power(power), trig))
+        total = sum_of_products(self.domain, triples)
         self._values[point] = total
         return total
 

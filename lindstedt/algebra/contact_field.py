@@ -39,16 +39,23 @@ fresh process) against the independent-generator fraction field: ``(u − κ)_+`
 with symbolic κ to order 5 4.4 s -> 0.5 s, order 6 ~18 s -> ~1 s, and the printed
 ω_1 … ω_6 from count_ops 16, 270, 2221, 7106, 19814, 41021 to 9, 39, 115, 227,
 384, 602; κ = 3/10 to order 10 ~62 s -> 0.8 s; two springs (u − 1/4)_+ −
-2(−u − 1/2)_+ to order 4 4.7 s -> 0.1 s.  sympy's ``PolyElement`` (dict of
-exponent tuples, gmpy2 rationals) carries the polynomial arithmetic; the only
-hand-written polynomial step is the reduction ``x_j² → r_j`` after a product
-(one pass over the terms).
+2(−u − 1/2)_+ to order 4 4.7 s -> 0.1 s.
 
-The printed form (:meth:`ContactField.to_sympy`) goes back to σ of degree ≤ 1:
-``σ² -> 1 − κ²`` in the numerator, ``σ^b`` of the denominator to ``(1 − κ²)^(b/2)``
-with the factors ``1 ∓ κ`` that divide the numerator cancelled; the terms are
-collected by their powers of π and β, each coefficient factored over QQ in κ (and
-split by its power of σ), over one integer denominator.
+Representation (issue 26): an element is stored packed — the numerator as integer
+coefficients keyed by one int per monomial (the exponent of generator i in bits
+[16 i, 16 i + 16), so a monomial product is one integer addition) over one positive
+common denominator, the denominator monomial as one int — and the products are a
+loop over pairs of terms with ``x_j² -> r_j`` folded in (:meth:`ContactField._accumulate`);
+sympy ring elements only for a non-monomial denominator and for printing
+(:mod:`lindstedt.algebra._contact_printing`).  A sum of products over a common
+denominator (:func:`sum_of_products`: the Taylor terms at a moving contact point, a
+branch's value there) is accumulated and normalized once.  Measured (2 shared cores,
+``expand(...).omega`` warm, CPU): κ = 3/10 to order 10 0.77 s -> ~0.25 s (the 30-digit
+Cauchy integral of the exact period, the floor of issue 26: 36 ms); symbolic κ to
+order 6 0.63 s -> ~0.2 s; the printed ω unchanged.  Tried and dropped: numpy
+object arrays for the pairs (no faster: the cost is the Python-int products), gmpy2
+coefficients (−7 % at 70 bits, +20 % for the symbolic κ), single-digit keys (−12 %
+of the loop, at a 2^7 bound on the degrees).
 
 Examples
 --------
@@ -80,9 +87,10 @@ from sympy.polys.polyerrors import CoercionFailed
 from sympy.polys.rings import PolyElement, PolyRing
 
 from .._precision import LOCK
+from ._contact_printing import to_sympy
 from .cosine import power_by_squaring
 
-__all__ = ["ContactElement", "ContactField"]
+__all__ = ["ContactElement", "ContactField", "sum_of_products"]
 
 # Positional generator symbols (module-level Dummies: π, the i-th angle β_i, the i-th symbolic sine σ_i, the
 # i-th prime root): a ring depends only on the structure of the problem, so a new κ in a warm process reuses
@@ -94,7 +102,6 @@ _ROOTS: dict[int, sympy.Dummy] = {}
 _RINGS: dict[tuple, PolyRing] = {}
 _FIELDS: dict[tuple, "ContactField"] = {}
 _FIELD_CACHE_SIZE = 64
-_SHORT = 12  # numerators of at most this many terms print both ways (σ kept in the denominator or not)
 _TRIAL_LIMIT = 2**15  # radicands are factored by trial division up to this (larger factors: primes or squares)
 # Packed monomials: the exponent of generator i in bits [i W, (i + 1) W) of one int.  A product (or a sum of
 # products over a common denominator) checks that its factors' exponents are below 2^(W − 2), so the sum of two
@@ -351,7 +358,7 @@ class ContactField:
         Written ``Σ_{i,j} π^i β^j c_ij / d`` with ``c_ij`` collected over the remaining generators
         (each a short polynomial in κ and σ) and ``d`` the rational part of the denominator.
         """
-        return _to_sympy(self, element)
+        return to_sympy(self, element.num, element.den)
 
     def of_type(self, value: Any) -> bool:
         return isinstance(value, ContactElement) and value.field is self
@@ -722,108 +729,20 @@ class ContactElement:
     __str__ = __repr__
 
 
-def _sine_reduced(field: ContactField, numerator: PolyElement, denominator: PolyElement, keep_sine: bool = True) -> tuple:
-    """Rewrite N / D for printing: σ² -> 1 − κ² in N, σ^b in D -> σ^(b mod 2) (1 − κ²)^(b // 2).
+def sum_of_products(domain: Any, triples: list[tuple[Any, Any, Any]]) -> Any:
+    """``Σ a · b · c`` over ``triples``, added in their order; a domain with its own ``sum_of_products``
+    (:class:`ContactField`: one accumulation, normalized once) uses it.
 
-    Returns ``(N', D', factors)``: ``N'`` of degree ≤ 1 in every σ, ``D'`` free of σ and ``factors`` the list of
-    ``(base, exponent)`` of the (1 − κ²), or of (1 − κ) and (1 + κ) apart, left after cancelling those dividing ``N'``.
+    Examples
+    --------
+    >>> from sympy import QQ
+    >>> print(sum_of_products(QQ, [(QQ(1), QQ(2), QQ(3)), (QQ(1, 2), QQ(1, 3), QQ(6))]))
+    7
     """
-    ring = field.ring
-    factors = []
-    for kappa_index, rhs in field.reduced:
-        if not isinstance(rhs, PolyElement):
-            continue
-        sine_index = [i for i, exponent in enumerate(max(rhs.monoms())) if exponent][0]
-        kappa = ring.gens[kappa_index]
-        one_minus = ring.one - kappa**2
-        exponent = 0
-        if len(denominator) == 1:
-            [(monom, coefficient)] = denominator.items()
-            exponent = monom[sine_index]
-            if exponent:  # an odd power keeps one σ in the denominator
-                denominator = ring.dtype({monom[:sine_index] + (exponent % 2 if keep_sine else 0,) + monom[sine_index + 1:]: coefficient})
-                if exponent % 2 and not keep_sine:
-                    numerator = numerator * ring.gens[sine_index]
-                    exponent += 1
-        groups: dict[int, dict] = {}
-        for monom, value in numerator.items():
-            quotient, remainder = divmod(monom[sine_index], 2)
-            groups.setdefault(quotient, {})[monom[:sine_index] + (remainder,) + monom[sine_index + 1:]] = value
-        numerator = ring.zero
-        for quotient, terms in groups.items():
-            numerator = numerator + ring.dtype(terms) * one_minus**quotient
-        powers = []
-        for base in (ring.one - kappa, ring.one + kappa):
-            power = exponent // 2
-            while power:
-                quotient, remainder = numerator.div(base)
-                if remainder:
-                    break
-                numerator, power = quotient, power - 1
-            powers.append(power)
-        if powers[0] == powers[1] and powers[0]:
-            factors.append((one_minus, powers[0]))
-        else:
-            factors += [(base, power) for base, power in zip((ring.one - kappa, ring.one + kappa), powers) if power]
-    return numerator, denominator, factors
-
-
-def _to_sympy(field: ContactField, element: ContactElement) -> sympy.Expr:
-    """The printed form.  An odd power of σ in the denominator is multiplied into the numerator (shorter for
-    the frequency corrections: count_ops 115 against 122 for ω_3, 602 against 651 for ω_6 of (u − κ)_+), or,
-    for a short numerator, kept as one σ there when that prints shorter (``(σ − κ)/σ``)."""
-    numerator, denominator = element.num, element.den
-    if not field._sines or denominator == field._poly_one:
-        return _printed(field, *_sine_reduced(field, numerator, denominator, True))
-    expression = _printed(field, *_sine_reduced(field, numerator, denominator, False))
-    if len(numerator) <= _SHORT:
-        other = _printed(field, *_sine_reduced(field, numerator, denominator, True))
-        if sympy.count_ops(other) < sympy.count_ops(expression):
-            return other
-    return expression
-
-
-def _printed(field: ContactField, numerator: PolyElement, denominator: PolyElement, factors: list) -> sympy.Expr:
-    """Σ over the monomials in π and the angles β of (their powers) × (the factored coefficient in κ, σ, …) / denominator."""
-    values = field.values
-    common, numerator = numerator.clear_denoms()  # integer coefficients over one common denominator
-    outer = list(field._outer)
-    inner = [i for i in range(len(field.symbols)) if i not in outer]
-    groups: dict[tuple, dict] = {}
-    for monom, value in numerator.items():
-        groups.setdefault(tuple(monom[i] for i in outer), {})[tuple(monom[i] for i in inner)] = value
-    sines = list(field._sines)
-    ring = field.ring
-    width = len(field.symbols)
-
-    def _embed(monom: tuple) -> tuple:  # inner monomial -> full monomial (outer exponents zero)
-        full = [0] * width
-        for i, e in zip(inner, monom):
-            full[i] = e
-        return tuple(full)
-
-    def _strip(monom: tuple) -> tuple:  # drop the sines (their powers are 0 or 1, printed apart)
-        return tuple(0 if i in sines else e for i, e in enumerate(monom))
-    terms = []
-    for outer_monom, coefficient in groups.items():
-        head = sympy.Mul(*[values[i] ** e for i, e in zip(outer, outer_monom)])
-        # split by the powers (0 or 1) of the sines, factor each polynomial in the remaining inner generators
-        by_sine: dict[tuple, dict] = {}
-        for monom, value in coefficient.items():
-            key = tuple(monom[inner.index(i)] for i in sines)
-            by_sine.setdefault(key, {})[monom] = value
-        parts = []
-        for key, part in by_sine.items():
-            polynomial = ring.dtype({_embed(monom): value for monom, value in part.items() if True})
-            sine = sympy.Mul(*[values[i] ** e for i, e in zip(sines, key)])
-            if len(part) > 1 and sines:  # factor over QQ in the ring: (κ − 1)(κ + 1)², … (far cheaper than sympy.factor)
-                sine_free = ring.dtype({_strip(monom): value for monom, value in polynomial.items()})
-                content, factors_list = sine_free.factor_list()
-                parts.append(sine * QQ.to_sympy(content) * sympy.Mul(*[f.as_expr(*values) ** e for f, e in factors_list]))
-            else:
-                parts.append(polynomial.as_expr(*values))
-        terms.append(head * sympy.Add(*parts))
-    bottom = QQ.to_sympy(common) * denominator.as_expr(*values)
-    for base, power in factors:
-        bottom = bottom * base.as_expr(*values) ** power
-    return sympy.Add(*terms) / bottom
+    fused = getattr(domain, "sum_of_products", None)
+    if fused is not None:
+        return fused(triples)
+    total = domain.zero
+    for a, b, c in triples:
+        total = total + a * b * c
+    return total

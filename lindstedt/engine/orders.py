@@ -11,9 +11,10 @@ from typing import Any, Callable
 from sympy import Rational
 
 from .._precision import locked
+from ..algebra.contact_field import sum_of_products
 from ..limits import checkpoint
 
-__all__ = ["LazyOrders", "extend_square_root", "shift_powers", "sum_of_products"]
+__all__ = ["LazyOrders", "extend_square_root", "shift_powers"]
 
 
 def extend_square_root(roots: list[Any], squared: Callable[[int], Any], order: int, domain: Any) -> Any:
@@ -52,38 +53,19 @@ def shift_powers(shifts: list[Any], order: int, domain: Any, previous: tuple[int
     >>> [str(c) for c in shift_powers([QQ(0), QQ(2), QQ(3)], 3, QQ, (2, shift_powers([QQ(0), QQ(2)], 2, QQ)))[2]]
     ['0', '0', '4', '12']
     """
-    zero = domain.zero
+    zero, one = domain.zero, domain.one
     padded = [zero] + [shifts[i] if i < len(shifts) else zero for i in range(1, order + 1)]
     known = min(len(shifts), order + 1)
-    powers = [[domain.one] + [zero] * order]
+    powers = [[one] + [zero] * order]
     for power in range(1, order + 1):
         last = powers[-1]
         row: list[Any] = []
         if previous is not None and power < len(previous[1]):
             earlier = previous[1][power]
             row = earlier[:max(0, min(order, len(earlier) - 1, min(previous[0], known) + power - 2) + 1)]
-        row += [sum((last[j - i] * padded[i] for i in range(1, j + 1)), zero) for j in range(len(row), order + 1)]
+        row += [sum_of_products(domain, [(last[j - i], padded[i], one) for i in range(1, j + 1)]) for j in range(len(row), order + 1)]
         powers.append(row)
     return powers
-
-
-def sum_of_products(domain: Any, triples: list[tuple[Any, Any, Any]]) -> Any:
-    """``Σ a · b · c`` over ``triples``, added in their order; a domain with its own ``sum_of_products``
-    (:class:`~lindstedt.algebra.contact_field.ContactField`: one accumulation, normalized once) uses it.
-
-    Examples
-    --------
-    >>> from sympy import QQ
-    >>> print(sum_of_products(QQ, [(QQ(1), QQ(2), QQ(3)), (QQ(1, 2), QQ(1, 3), QQ(6))]))
-    7
-    """
-    fused = getattr(domain, "sum_of_products", None)
-    if fused is not None:
-        return fused(triples)
-    total = domain.zero
-    for a, b, c in triples:
-        total = total + a * b * c
-    return total
 
 
 class LazyOrders:
