@@ -170,7 +170,11 @@ class VectorArc:
         self.size = len(self.ratios)
         self._fixed: list[tuple[list[Any], Any]] = []  # (h_k, μ_n) of orders 1, 2, …
         self._pending: tuple[int, list[dict]] | None = None
-        self.nodes = _INITIAL_NODES
+        # the grid resolves cos(β r_k τ) of the stiffest component, d·β r_k oscillations in v near τ = 0: start at
+        # the power of two below d·β·max r_k (chains of 40 and 200 dof needed 256 and 512 nodes for 40 and 135 —
+        # starting at 32 cost three and four restarts, each redoing the grid's trigonometry and the fixed orders)
+        stiffest = float(self.beta) * max(abs(float(r)) for r in self.ratios) * self.denominator
+        self.nodes = max(_INITIAL_NODES, min(_MAXIMUM_NODES, 1 << max(0, int(math.log2(max(stiffest, 1.0))))))
         self._reset()
         self.counters = {"orders": 0, "restarts": 0}
 
