@@ -15,7 +15,7 @@ import sympy
 
 import lindstedt
 from lindstedt.algebra import contact_ramp_coefficient
-from lindstedt.algebra.contact_field import ContactField
+from lindstedt.algebra.contact_field import ContactField, sum_of_products
 from lindstedt.references import frequency_taylor_coefficients, piecewise_linear_frequency_taylor
 
 KAPPA = sympy.Symbol("kappa")
@@ -65,6 +65,36 @@ def test_quotients_agree_with_mpmath(numerator, denominator):
         for kappa in (mpmath.mpf(3) / 10, mpmath.mpf(-5) / 7, mpmath.mpf(9) / 10):
             expected = _value(numerator, kappa) / _value(denominator, kappa)
             assert abs(_value(printed, kappa) - expected) <= mpmath.mpf(10) ** -35 * abs(expected)
+
+
+@pytest.mark.parametrize("general", [False, True])
+def test_sums_of_products_agree_with_mpmath(general):
+    # one accumulation over the common denominator (π^m σ^n, or π + κ: the general path), against term-wise values
+    field = _symbolic_field()
+    terms = [
+        (sympy.pi * KAPPA * SINE - sympy.Rational(3, 7), sympy.acos(KAPPA) ** 2 / sympy.pi**3, sympy.Rational(-5, 6)),
+        (KAPPA / SINE**3, SINE * KAPPA + sympy.pi, 1 / (sympy.pi + KAPPA) if general else sympy.Rational(1, 24)),
+        (sympy.acos(KAPPA) / sympy.pi, 1 - KAPPA**2, sympy.pi * SINE),
+        (0, KAPPA, 1),
+    ]
+    total = sum_of_products(field, [tuple(field.from_sympy(x) for x in triple) for triple in terms])
+    assert total == sum((field.from_sympy(a) * field.from_sympy(b) * field.from_sympy(c) for a, b, c in terms), field.zero)
+    printed = field.to_sympy(total)
+    with mpmath.workdps(40):
+        for kappa in (mpmath.mpf(3) / 10, mpmath.mpf(-5) / 7):
+            expected = sum(_value(a, kappa) * _value(b, kappa) * _value(c, kappa) for a, b, c in terms)
+            assert abs(_value(printed, kappa) - expected) <= mpmath.mpf(10) ** -35 * abs(expected)
+
+
+def test_powers_beyond_the_packed_exponents_are_refused():
+    field = _symbolic_field()
+    # one int per monomial, 16 bits per generator: a product takes factors with exponents below 2^14 (so that
+    # no sum carries into the next generator) and refuses the others instead of returning a wrong monomial
+    power = field.from_sympy(sympy.pi) ** 10000
+    square = power * power
+    assert field.to_sympy(square) == sympy.pi**20000
+    with pytest.raises(OverflowError):
+        square * power
 
 
 def test_rational_gaps_share_square_roots_of_primes():

@@ -50,9 +50,10 @@ sympy ring elements only for a non-monomial denominator and for printing
 (:mod:`lindstedt.algebra._contact_printing`).  A sum of products over a common
 denominator (:func:`sum_of_products`: the Taylor terms at a moving contact point, a
 branch's value there) is accumulated and normalized once.  Measured (2 shared cores,
-``expand(...).omega`` warm, CPU): κ = 3/10 to order 10 0.77 s -> ~0.25 s (the 30-digit
-Cauchy integral of the exact period, the floor of issue 26: 36 ms); symbolic κ to
-order 6 0.63 s -> ~0.2 s; the printed ω unchanged.  Tried and dropped: numpy
+``expand(...).omega`` after a warm-up, CPU, best of 3 fresh processes): κ = 3/10 to
+order 10 0.69 s -> 0.25 s (7× the floor of issue 26, the 30-digit Cauchy integral of
+the exact period: 35 ms), order 8 0.25 s -> 0.12 s; symbolic κ to order 6 0.59 s ->
+0.30 s; two springs to order 4 78 ms -> 57 ms; the printed ω unchanged.  Tried and dropped: numpy
 object arrays for the pairs (no faster: the cost is the Python-int products), gmpy2
 coefficients (−7 % at 70 bits, +20 % for the symbolic κ), single-digit keys (−12 %
 of the loop, at a 2^7 bound on the degrees).
