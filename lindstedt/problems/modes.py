@@ -449,22 +449,16 @@ class _PackedColumns:
         limbs = self._decode(self._columns)
         self._columns = []
         setup, rows = self._setup, self._rows
-        # pieces of `piece` bits (the top one signed): products < 2^(2·piece), sums over N exact in float64
-        piece = (53 - int(np.ceil(np.log2(rows + 1))) - 1) // 2
-        top = setup.p + max(0, int(np.ceil(np.log2(setup.magnitude)))) + 2
-        count = -(-top // piece)
+        # 16-bit pieces of each slot's two's complement (a view of its limbs) up to bit 16·count, above which every bit
+        # is the sign, and the sign itself (−1 at 2^(16·count)): products < 2^32, sums over N < 2^21 exact in float64
+        piece = 16
+        count = -(-(setup.p + max(0, int(np.ceil(np.log2(setup.magnitude)))) + 2) // piece)
         complement = limbs.copy()
         complement[..., -1] ^= _TOP  # two's complement of each slot
-        negative = limbs[..., -1] < _TOP
-        pieces = np.empty(limbs.shape[:2] + (count,))
-        for t in range(count):
-            index, bit = divmod(piece * t, 64)
-            value = complement[..., index] >> np.uint64(bit)
-            if bit + piece > 64 and index + 1 < self._limbs:
-                value |= complement[..., index + 1] << np.uint64(64 - bit)
-            value &= np.uint64((1 << piece) - 1)
-            pieces[..., t] = value.astype(float)
-        pieces[..., -1] -= np.where(negative, float(1 << piece), 0.0)
+        pieces = np.empty(limbs.shape[:2] + (count + 1,))
+        pieces[..., :count] = complement.view(np.uint16)[..., :count]
+        pieces[..., count] = np.where(limbs[..., -1] < _TOP, -1.0, 0.0)
+        count += 1
         lags: dict[int, list[int]] = {}
         for offset in {abs(o) for band in (setup.stiffness, setup.mass) for o in band.diagonals}:
             gram = np.matmul(pieces[:, :rows - offset].transpose(0, 2, 1), pieces[:, offset:])  # (block, t, u), exact
