@@ -337,7 +337,8 @@ def _native_limbs() -> bool:
 
     import gmpy2
 
-    return gmpy2.xmpz.limb_size == 8 and sys.byteorder == "little"
+    return (getattr(gmpy2.xmpz, "limb_size", 0) == 8 and sys.byteorder == "little"
+            and all(hasattr(gmpy2.xmpz, name) for name in ("limbs_read", "limbs_write", "limbs_finish", "num_limbs")))
 
 
 class _PackedColumns:

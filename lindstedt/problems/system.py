@@ -596,13 +596,14 @@ class UnilateralSystem:
         """λ_k, ``B = A Φ`` (m×N) and ``G = Φᵀ W`` (N×m) to ``digits`` digits: all the modal normal form needs.
 
         The modes of :meth:`modes` (float64, LAPACK; tridiagonal or banded solvers when ``M`` is diagonal)
-        are refined in multiprecision: with the high-precision residuals ``R = K X − M X Θ`` (products
-        with the band of K and M, O(N² · bandwidth)), each sweep corrects every mode in float64 by its
-        projections on the float modes, ``x_k −= Σ_{l≠k} x̃_l (x̃_lᵀ r_k)/(θ_l − θ_k)`` — linear
-        convergence by a factor ~1e-16 · max θ / min gap per sweep — and θ_k is the final Rayleigh quotient.
-        The working precision adds guard bits for the spread of the θ_k and for the smallest gap, so every
-        λ_k (not only the largest) and every B_ik, G_ki is accurate to ``digits`` digits.  Near-repeated
-        frequencies (relative gap < 1e-9) fall back to a dense mpmath decomposition.
+        are refined in fixed-point multiprecision a block of modes at a time: each sweep forms the exact
+        residuals ``R = K X − M X Θ`` from the bands of K and M and corrects every mode in float64 — by a shifted
+        banded solve with ``K − θ̃_k M`` when the band is narrow (O(N · bandwidth) a mode), else by its
+        projections on the float modes, ``x_k −= Σ_{l≠k} x̃_l (x̃_lᵀ r_k)/(θ_l − θ_k)`` (O(N²)) — and θ_k is
+        the final Rayleigh quotient (:mod:`lindstedt.problems.modes`).  The working precision adds guard bits
+        for the spread of the θ_k and for the smallest gap, so every λ_k (not only the largest) and every B_ik,
+        G_ki is accurate to ``digits`` digits.  Near-repeated frequencies fall back to a dense mpmath
+        decomposition.  Every mode's full shape is refined: O(N²) numbers of ``digits`` digits per sweep.
 
         Examples
         --------
