@@ -214,12 +214,14 @@ def _advice(problem: Any, features: ExpansionFeatures, precision: int) -> str:
     return "ask for a lower order"
 
 
-#: The NNM expansion of an N-dof system with S springs: T = (_NNM[0] · N^1.25 + [order ≥ 3] _NNM[1] · N^1.6 ·
-#: 2.5^(order − 3)) · (S/3)^1.084 CPU seconds.  Recalibrated on the benchmark chain (3 springs) after the issue-26
+#: The NNM expansion of an N-dof system with S springs: T = _NNM[0] · N^1.25 (S/3)^0.2 + [order ≥ 3] _NNM[1] · N^1.6 ·
+#: 2.5^(order − 3) (S/3)^1.084 CPU seconds.  Recalibrated on the benchmark chain (3 springs) after the issue-26
 #: modal refinement (packed columns, banded corrections): order ≤ 2 is the modal coupling, 0.28 / 0.30 s at N = 200
 #: (orders 1, 2), 0.60 s at 500, 1.40 s at 1000, ~4.5 s at 2000; from order 3 the hierarchy's combination tones
 #: dominate, 0.6 / 1.55 / 5.5 s at N = 50 / 100 / 200 (order 3) and ×2.5 an order (N = 50: 1.51 s at order 4,
-#: 3.83 s at 5).  The constants carry 1.2–1.3× of margin; the springs' exponent is the earlier fit's.
+#: 3.83 s at 5).  The coupling hardly depends on S (1000 dof, order 2: 1.28 s with one spring, 1.40 s with three;
+#: 200 dof: 0.21 / 0.30 / 0.35 s with 1 / 3 / 6); the tones' springs exponent is the earlier fit's.  The constants carry
+#: 1.2–1.5× of margin.
 _NNM = (3.4e-4, 1.2e-3)
 #: Its memory: the float modal matrices (``_NNM_MEMORY[0] · N²`` MB: the modes, their gaps and projections; the
 #: fixed-point shapes are refined a block at a time — chain of 1000 dof 118 MB, 2000 dof 369 MB) or the hierarchy
@@ -269,7 +271,8 @@ def nnm_estimate(system: Any, mode: int, order: int) -> Estimate:
     """The :class:`~lindstedt.limits.Estimate` of the strained-coordinates NNM of ``system`` to ``order``."""
     n, springs = system.n_dof, max(len(system.b), 1)
     coupling, tones = _NNM
-    seconds = (coupling * n**1.25 + (tones * n**1.6 * 2.5 ** (order - 3) if order >= 3 else 0.0)) * (springs / 3) ** 1.084
+    seconds = coupling * n**1.25 * (springs / 3) ** 0.2 + (tones * n**1.6 * 2.5 ** (order - 3) * (springs / 3) ** 1.084
+                                                           if order >= 3 else 0.0)
     arc, products = _law_costs(system)
     seconds += arc * n * (order + 1)
     if products and order >= 3:
