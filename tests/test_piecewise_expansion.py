@@ -212,6 +212,16 @@ def test_bad_piecewise_inputs():
         lindstedt.expand("Max(0, u)*exp(u)*Heaviside(1/2 - u)", order=1, a0=1, omega0=1)
     with pytest.raises(lindstedt.ProblemError, match="sign of a0"):
         lindstedt.expand("Max(0, u)", order=1, a0=sympy.Symbol("A", real=True))
+    # the float field holds numbers: a symbolic a0 or gap with numeric=True is refused by name (it raised sympy's
+    # CoercionFailed before); a symbolic omega0 is fine, it scales out
+    with pytest.raises(lindstedt.ProblemError, match="numeric values for a0"):
+        lindstedt.expand("Max(0, u - 1/3)", order=2, numeric=True)
+    with pytest.raises(lindstedt.ProblemError, match="numeric values for a0, kappa"):
+        lindstedt.expand("Max(0, u - kappa)", order=2, params={"kappa": None}, numeric=True)
+    omega0 = sympy.Symbol("omega0", positive=True)
+    scaled = lindstedt.expand("Max(0, u - 1/3)", order=2, a0=1, numeric=True).omega
+    unit = lindstedt.expand("Max(0, u - 1/3)", order=2, a0=1, omega0=1, numeric=True).omega
+    assert [sympy.expand(value * omega0 ** (2 * k - 1)) for k, value in enumerate(scaled)] == list(unit)
 
 
 @pytest.mark.parametrize("kappa", ["1 - 1/10**12", "-1 + 1/10**12", "1 - 1/10**6"])

@@ -462,6 +462,14 @@ def _assemble(
     angles = [] if numeric else [value for kappa in crossing_kappas for value in (kappa, sympy.acos(kappa), _contact_sine(kappa))]
     values = laws + angles + shifts + releases
     if numeric:
+        # a float field holds numbers only; ω0 alone may stay symbolic (ε̂ = ε/ω0² scales it out)
+        unknown = set().union(*(sympy.S(value).free_symbols for value in values)) - problem.omega0.free_symbols
+        if unknown:
+            names = ", ".join(sorted(str(symbol) for symbol in unknown))
+            raise ProblemError(
+                f"f = {problem.f} is expanded in floating point (numeric=True, or a float in the data), which needs "
+                f"numeric values for {names}; give them (a0=..., params={{...}}) or drop numeric=True and use exact numbers"
+            )
         digits = (digits or 30) + _guard_digits(crossing_kappas, order_hint)
         # a nonlinear polynomial law loses about half a digit per order to cancellation in the branch products
         # (measured: (u - 1/3)_+^2 at 30 digits, ω_6 to 9e-27 relative without this): one guard digit per order
