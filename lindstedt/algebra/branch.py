@@ -35,7 +35,7 @@ from sympy import QQ
 from .._precision import LOCK
 from .contact_field import sum_of_products
 
-__all__ = ["Branch", "EvaluationPoint"]
+__all__ = ["Branch", "EvaluationPoint", "domain_constant"]
 
 # A term key is (harmonic j >= 0, parity 0 = cos / 1 = sin, power m >= 0); (0, 1, m) never occurs.
 TermKey = tuple[int, int, int]
@@ -44,6 +44,37 @@ _RationalTerms = tuple[tuple[TermKey, Any], ...]
 
 #: a RealField harmonic is snapped to this many bits fewer than the field's precision (to an integer within it)
 _SNAP_BITS = 24
+
+
+#: per domain (by identity): its conversions of small integers and rationals, made once (a float field's
+#: ``convert`` is ~2 µs, and the hierarchy asks for the same few constants at every order); bounded
+_CONSTANTS: dict[int, tuple[Any, dict]] = {}
+_MAX_DOMAINS, _MAX_CONSTANTS = 64, 4096
+
+
+def domain_constant(domain: Any, value: Any) -> Any:
+    """``domain.convert(value)`` for an integer or ``QQ`` ``value``, converted once per domain.
+
+    Examples
+    --------
+    >>> from sympy import QQ, RealField
+    >>> field = RealField(dps=20)
+    >>> domain_constant(field, QQ(1, 2)) == field.convert(QQ(1, 2)), str(domain_constant(QQ, 3))
+    (True, '3')
+    """
+    entry = _CONSTANTS.get(id(domain))
+    if entry is None or entry[0] is not domain:
+        with LOCK:
+            if len(_CONSTANTS) >= _MAX_DOMAINS:
+                _CONSTANTS.clear()
+            entry = _CONSTANTS[id(domain)] = (domain, {})
+    table = entry[1]
+    result = table.get(value)
+    if result is None:
+        result = domain.convert(value)
+        if len(table) < _MAX_CONSTANTS:
+            table[value] = result  # a race stores the same value twice: harmless
+    return result
 
 
 def _snapped(harmonic: Any, domain: Any) -> Any:
@@ -126,10 +157,10 @@ def _general_oscillator_inverse(key: tuple, frequency: Any, domain: Any, memo: d
         harmonic = frequency
         top = (harmonic, 1 - parity, power + 1)
         sign = 1 if parity == 0 else -1
-        scale = domain.one / (domain.convert(2 * (power + 1)) * frequency)
-        _add_into(result, top, scale * domain.convert(sign))
+        scale = domain.one / (domain_constant(domain, 2 * (power + 1)) * frequency)
+        _add_into(result, top, scale * domain_constant(domain, sign))
         if power >= 1:
-            residual = domain.convert(sign * power) / (domain.convert(2) * frequency)
+            residual = domain_constant(domain, sign * power) / (domain_constant(domain, 2) * frequency)
             for sub_key, value in _general_oscillator_inverse((harmonic, 1 - parity, power - 1), frequency, domain, memo).items():
                 _add_into(result, sub_key, -residual * value)
     else:
@@ -137,10 +168,10 @@ def _general_oscillator_inverse(key: tuple, frequency: Any, domain: Any, memo: d
         _add_into(result, key, factor)
         residuals = []
         if power >= 2:
-            residuals.append(((harmonic, parity, power - 2), domain.convert(power * (power - 1))))
+            residuals.append(((harmonic, parity, power - 2), domain_constant(domain, power * (power - 1))))
         if power >= 1 and harmonic:
             sign = -1 if parity == 0 else 1
-            residuals.append(((harmonic, 1 - parity, power - 1), domain.convert(sign * 2 * power) * harmonic))
+            residuals.append(((harmonic, 1 - parity, power - 1), domain_constant(domain, sign * 2 * power) * harmonic))
         for residual_key, coefficient in residuals:
             for sub_key, value in _general_oscillator_inverse(residual_key, frequency, domain, memo).items():
                 _add_into(result, sub_key, -factor * coefficient * value)
@@ -295,14 +326,18 @@ class Branch:
         return Branch(self.domain, {key: value * factor for key, value in self.terms.items()})
 
     def _from_rational(self, rational_terms: Iterable[tuple[TermKey, Any]], factor: Any, into: dict) -> None:
-        convert = self.domain.convert
+        domain = self.domain
         for key, value in rational_terms:
-            _add_into(into, key, factor * convert(value))
+            _add_into(into, key, factor * domain_constant(domain, value))
 
     def derivative(self) -> "Branch":
         """d/ds, exactly."""
         result: dict[TermKey, Any] = {}
-        convert = self.domain.convert
+        domain = self.domain
+
+        def convert(value: int) -> Any:
+            return domain_constant(domain, value)
+
         for (harmonic, parity, power), value in self.terms.items():
             if power:
                 _add_into(result, (harmonic, parity, power - 1), value * convert(power))
@@ -322,7 +357,7 @@ class Branch:
         cos(2*s)/2 + 1/2
         """
         result: dict[TermKey, Any] = {}
-        half = self.domain.convert(QQ(1, 2))
+        half = domain_constant(self.domain, QQ(1, 2))
         for (j, parity, power), value in self.terms.items():
             for (k, other_parity, other_power), other_value in other.terms.items():
                 product = value * other_value * half
@@ -347,7 +382,7 @@ class Branch:
     def times_cosine(self, harmonic: int) -> "Branch":
         """Product with cos(harmonic · s) (product-to-sum)."""
         result: dict[TermKey, Any] = {}
-        half = self.domain.convert(QQ(1, 2))
+        half = domain_constant(self.domain, QQ(1, 2))
         for (j, parity, power), value in self.terms.items():
             half_value = value * half
             _add_into(result, (j + harmonic, parity, power), half_value)

@@ -17,31 +17,59 @@ __all__ = ["solve_linear"]
 
 
 class _Affine:
-    """A value of order n, affine in the unknowns (A_n, c_1 … c_N): base + Σ coefficient·unknown."""
+    """A value of order n, affine in the unknowns (A_n, c_1 … c_N): base + Σ coefficient·unknown.
 
-    __slots__ = ("base", "coefficients")
+    Sparse: ``terms`` maps an unknown's index to its coefficient (absent: zero) — most values involve one or two
+    of the unknowns; a zero is never multiplied or added (``0 · x`` and ``0 + x`` are exact, so the values are those
+    of the dense arithmetic, bit for bit in a float field, and ``value`` adds in the unknowns' order as it did).
+    """
 
-    def __init__(self, base: Any, coefficients: list[Any]):
+    __slots__ = ("base", "terms")
+
+    def __init__(self, base: Any, terms: dict[int, Any]):
         self.base = base
-        self.coefficients = coefficients
+        self.terms = terms
 
     def __add__(self, other: "_Affine") -> "_Affine":
-        return _Affine(self.base + other.base, [a + b for a, b in zip(self.coefficients, other.coefficients)])
+        terms = dict(self.terms)
+        for index, value in other.terms.items():
+            terms[index] = terms[index] + value if index in terms else value
+        return _Affine(_plus(self.base, other.base), terms)
 
     def __sub__(self, other: "_Affine") -> "_Affine":
-        return _Affine(self.base - other.base, [a - b for a, b in zip(self.coefficients, other.coefficients)])
+        terms = dict(self.terms)
+        for index, value in other.terms.items():
+            terms[index] = terms[index] - value if index in terms else -value
+        base, subtracted = self.base, other.base
+        return _Affine((base - subtracted if base else -subtracted) if subtracted else base, terms)
 
     def scale(self, factor: Any) -> "_Affine":
-        return _Affine(self.base * factor, [a * factor for a in self.coefficients])
+        base = self.base
+        return _Affine(base * factor if base else base, {index: value * factor for index, value in self.terms.items()})
 
     def shift(self, constant: Any) -> "_Affine":
-        return _Affine(self.base + constant, list(self.coefficients))
+        return _Affine(_plus(self.base, constant), dict(self.terms))
 
     def value(self, unknowns: Sequence[Any]) -> Any:
         total = self.base
-        for coefficient, unknown in zip(self.coefficients, unknowns):
-            total = total + coefficient * unknown
+        for index in sorted(self.terms):
+            total = total + self.terms[index] * unknowns[index]
         return total
+
+    def dense(self, count: int, zero: Any) -> list[Any]:
+        """The coefficients of the first ``count`` unknowns as a list (zeros included)."""
+        return [self.terms.get(index, zero) for index in range(count)]
+
+
+def _plus(a: Any, b: Any) -> Any:
+    """a + b, without adding a zero."""
+    if not b:
+        return a
+    return a + b if a else b
+
+
+#: 10^−(digits − 3) per working digits: the singularity threshold of :func:`solve_linear` relative to the largest entry
+_THRESHOLDS: dict[int, Any] = {}
 
 
 def solve_linear(matrix: list[list[Any]], vector: list[Any], domain: Any, order: int) -> list[Any]:
@@ -59,7 +87,12 @@ def solve_linear(matrix: list[list[Any]], vector: list[Any], domain: Any, order:
     threshold = None
     if not exact:
         scale = max((abs(entry) for row in matrix for entry in row), default=domain.one) or domain.one
-        threshold = scale * mpmath.mpf(10) ** (-(domain.dps - 3))
+        relative = _THRESHOLDS.get(domain.dps)
+        if relative is None:
+            if len(_THRESHOLDS) >= 256:
+                _THRESHOLDS.clear()
+            relative = _THRESHOLDS[domain.dps] = mpmath.mpf(10) ** (-(domain.dps - 3))
+        threshold = scale * relative
     for column in range(size):
         if exact:
             pivot = next((r for r in range(column, size) if rows[r][column]), None)

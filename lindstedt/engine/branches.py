@@ -56,7 +56,9 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 
-from ..algebra.branch import Branch, EvaluationPoint
+from sympy import QQ
+
+from ..algebra.branch import Branch, EvaluationPoint, domain_constant
 from .._precision import locked
 from .orders import LazyOrders, shift_powers, sum_of_products
 from .affine import _Affine, solve_linear
@@ -348,7 +350,7 @@ class BranchHierarchy(LazyOrders):
         factorial = 1
         for times in range(1, order + 1):
             factorial *= times
-            inverse = domain.one / domain.convert(factorial)
+            inverse = domain_constant(domain, QQ(1, factorial))
             for j in range(0, order - times + 1):
                 weight = powers[times][order - j]
                 if weight:
@@ -368,7 +370,7 @@ class BranchHierarchy(LazyOrders):
                 factorial *= times + 1
                 weight = powers[times + 1][order - j]
                 if weight:
-                    total = total + derivative.evaluate(point) * weight / domain.convert(factorial)
+                    total = total + derivative.evaluate(point) * weight / domain_constant(domain, factorial)
                 derivative = derivative.derivative()
         return total
 
@@ -425,10 +427,10 @@ class BranchHierarchy(LazyOrders):
         unknown_count = bottom_base + (size + 1 if bottom is not None else 0)
 
         def constant(value: Any) -> _Affine:
-            return _Affine(value, [zero] * unknown_count)
+            return _Affine(value, {})
 
         def unit(index: int) -> _Affine:
-            return _Affine(zero, [one if position == index else zero for position in range(unknown_count)])
+            return _Affine(zero, {index: one})
 
         last_piece = len(system.states) - 1
         particular: list[list[Branch]] = []
@@ -555,7 +557,7 @@ class BranchHierarchy(LazyOrders):
             equations.append(release if prescribed is None else release.shift(-prescribed))
         else:
             equations.append(self._first_harmonic_condition(order, particular, c_values, d_values, unit(0), components.index(mode)))
-        unknowns = solve_linear([list(e.coefficients) for e in equations], [-e.base for e in equations], domain, order)
+        unknowns = solve_linear([e.dense(unknown_count, zero) for e in equations], [-e.base for e in equations], domain, order)
         branches = [[None] * system.size for _ in system.states] if coupled else self._branches[order]
         for piece in range(len(system.states)):
             if (piece == 0 and top is not None) or (piece == last_piece and bottom is not None):

@@ -33,6 +33,8 @@ from typing import Any, Sequence
 
 import mpmath
 import sympy
+from mpmath.libmp import fzero, from_int, from_rational, mpf_acos, mpf_add, mpf_div, mpf_mul, mpf_pi, mpf_pos, mpf_sqrt, \
+    round_nearest
 from sympy import QQ, RealField
 from sympy.polys.polyerrors import CoercionFailed
 
@@ -43,7 +45,7 @@ from ..algebra.branch import EvaluationPoint
 from ..algebra.contact_field import ContactField
 from .branches import BranchHierarchy, BranchSystem, ContactState, MovingBoundary
 from .stretched import VectorArc
-from .._precision import locked, workdps
+from .._precision import LOCK, locked, workdps
 
 __all__ = ["ContactBoundary", "PiecewiseNormalForm", "contact_normal_form"]
 
@@ -142,6 +144,19 @@ class _ConstantField:
             self._register(value)
         self.domain = QQ.frac_field(*[generator for generator, _ in self.generators])
 
+    def contact_point(self, kappa: sympy.Expr, angle: sympy.Expr) -> tuple[Any, Any, Any]:
+        """(β, κ, sin β) as elements for the crossing κ with ``angle`` = acos κ; a rational κ in a float field from
+        mpmath's acos and square root 64 bits beyond the field's precision, rounded once (sympy's evaluation of
+        acos κ and sqrt(1 − κ²), ~0.2 ms, gave the same bits on every one of 1200 random κ measured)."""
+        if not (self.numeric and isinstance(kappa, sympy.Rational)):
+            return self.convert(angle), self.convert(kappa), self.convert(_contact_sine(kappa, self.numeric))
+        p, q = int(kappa.p), int(kappa.q)
+        working = self.domain.precision + 64
+        angle_value = mpf_acos(from_rational(p, q, working, round_nearest), working, round_nearest)
+        sine_value = mpf_div(mpf_sqrt(from_int((q - p) * (q + p)), working, round_nearest), from_int(q), working,
+                             round_nearest)
+        return self.domain.from_raw(angle_value), self.convert(kappa), self.domain.from_raw(sine_value)
+
     def _register(self, value: sympy.Expr) -> None:
         for atom in sympy.preorder_traversal(value):
             if isinstance(atom, (sympy.acos, sympy.Pow, sympy.asin, sympy.atan)) and atom not in self._replacement:
@@ -154,6 +169,10 @@ class _ConstantField:
     def convert(self, value: sympy.Expr) -> Any:
         value = sympy.sympify(value, strict=True)
         if self.numeric:
+            if isinstance(value, sympy.Rational):  # p/q correctly rounded, no sympy evaluation
+                return self.domain.dtype(int(value.p)) / int(value.q)
+            if value is sympy.pi:
+                return self.domain.pi
             return self.domain.convert(sympy.N(value, self.digits + 10))
         if self.contact_field is not None:
             return self.contact_field.from_sympy(value)
@@ -201,14 +220,53 @@ def _contact_sine(kappa: sympy.Expr, numeric: bool = False) -> sympy.Expr:
     return sympy.sqrt(1 - kappa**2)
 
 
+class _FloatField(RealField):
+    """``RealField`` with the fused ``sum_of_products`` of :func:`~lindstedt.algebra.contact_field.sum_of_products`:
+    Σ a·b·c added in order on mpmath's raw values, each product and sum rounded to the field's precision as the
+    element arithmetic rounds it (the same bits), a factor that is the field's one skipped (multiplying an element
+    of the field by 1 rounds nothing).  Measured: ~0.2 µs per product or sum against ~0.5 µs through mpf objects."""
+
+    def __hash__(self) -> int:  # equal to RealField of its precision (RealField.__eq__), so hashed as one
+        return hash(("RealField", self._dtype, self.precision))
+
+    def sum_of_products(self, triples: Sequence[tuple[Any, Any, Any]]) -> Any:
+        prec, rounding = self._context._prec_rounding
+        one = self.one
+        total = fzero
+        for a, b, c in triples:
+            value = a._mpf_
+            if b is not one:
+                value = mpf_mul(value, b._mpf_, prec, rounding)
+            if c is not one:
+                value = mpf_mul(value, c._mpf_, prec, rounding)
+            total = mpf_add(total, value, prec, rounding)
+        return self._context.make_mpf(total)
+
+    def from_raw(self, value: tuple) -> Any:
+        """The element nearest to mpmath's raw value ``value`` (any precision)."""
+        return self._context.make_mpf(mpf_pos(value, self._context.prec, round_nearest))
+
+    @property
+    def pi(self) -> Any:
+        """π rounded to the field's precision, made once per field."""
+        value = self.__dict__.get("_pi")
+        if value is None:
+            value = self.__dict__["_pi"] = self.from_raw(mpf_pi(self._context.prec + 64, round_nearest))
+        return value
+
+
 _REAL_FIELDS: dict[int, Any] = {}
 
 
 def _real_field(digits: int) -> Any:
-    """``RealField(dps=digits)``, made once per digits (each makes its own mpmath context, ~0.5 ms)."""
+    """``RealField(dps=digits)`` (:class:`_FloatField`), made once per digits (each makes its own mpmath context,
+    ~0.5 ms)."""
     field = _REAL_FIELDS.get(digits)
     if field is None:
-        field = _REAL_FIELDS[digits] = RealField(dps=digits)
+        with LOCK:
+            field = _REAL_FIELDS.get(digits)
+            if field is None:
+                field = _REAL_FIELDS[digits] = _FloatField(dps=digits)
     return field
 
 
@@ -487,9 +545,8 @@ def _assemble(
         moving.append(MovingBoundary(zero, (domain.one,), domain.zero, field.convert(first_shift)))
     for kappa in sorted(crossing_kappas, key=lambda k: -k if k.is_number else 0):
         angle = sympy.acos(kappa)
-        kappa_element = field.convert(kappa)
-        sine_element = field.convert(_contact_sine(kappa, field.numeric))
-        point = EvaluationPoint(domain, field.convert(angle), kappa_element, sine_element)
+        angle_element, kappa_element, sine_element = field.contact_point(kappa, angle)
+        point = EvaluationPoint(domain, angle_element, kappa_element, sine_element)
         boundaries.append(ContactBoundary(kappa, angle, point, kappa_element, sine_element))
         moving.append(MovingBoundary(point, (domain.one,), sine_element))
     for kappa, _, first_shift in bottom:
