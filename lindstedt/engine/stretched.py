@@ -66,6 +66,27 @@ __all__ = ["FloatArc", "VectorArc"]
 _INITIAL_NODES = 32
 _MAXIMUM_NODES = 1024
 _GUARD_DIGITS = 20
+_TWO = gmpy2.mpfr(2)
+
+
+def _mpfr(value: Any) -> Any:
+    """An mpmath number (or anything mpmath reads) as a gmpy2 mpfr of the current gmpy2 precision, exactly when the
+    mantissa fits."""
+    sign, mantissa, exponent, _ = mpmath.mpf(value)._mpf_
+    result = gmpy2.mul_2exp(gmpy2.mpfr(mantissa), exponent)
+    return -result if sign else result
+
+
+def _mpf(value: Any) -> Any:
+    """A gmpy2 mpfr as an mpmath mpf (exact at mpmath's current precision ≥ the mpfr's)."""
+    mantissa, exponent = value.as_mantissa_exp()
+    return mpmath.mpf((int(mantissa), int(exponent)))
+
+
+def _array(values: Sequence[Any]) -> np.ndarray:
+    """A one-dimensional object array (``np.array`` of gmpy2 numbers is 70 times slower: it probes each for a
+    sequence)."""
+    return np.fromiter(values, dtype=object, count=len(values))
 
 
 class _FixedPointTransform:
@@ -78,23 +99,25 @@ class _FixedPointTransform:
     GMP product of Kronecker-packed vectors (:func:`~lindstedt.algebra.cosine._pack`).  x is scaled to integers
     relative to its largest entry and the chirp's values to 2^bits; the rounding adds ~4 M 2^-bits of the largest
     entry (the guard bits cover M ≤ 1024 four times over).  Only the 4M values of ``w^e`` are computed, not the M²
-    entries of T.  Measured at 50 digits against the integer matrix product it replaces (numpy object arrays, itself
-    5x faster than ``mpmath.fsum``), M = 32 / 128 / 512: a transform 0.25 / 1.0 / 4.8 ms against 0.24 / 2.0 / 27 ms,
-    the set-up 2.4 / 7 / 47 ms against 7 / 104 / 1860 ms (the M² mpmath cosines of T, most of a grid refinement);
-    the same values to the working precision (7e-49 relative at M = 512).
+    entries of T.  The per-node work is numpy object arrays of gmpy2 integers; in and out go gmpy2 mpfr at the
+    caller's gmpy2 precision.  Measured at 61 digits, M = 1024: 5.5 ms a transform (9.3 ms with mpmath numbers in
+    and out), of which 4 ms are the three GMP products.
     """
 
     def __init__(self, size: int, digits: int):
         self.size = size
         self.bits = int(digits * 3.33) + 28
         period = 4 * size  # w^e depends on e mod 4M
-        with workprec(self.bits + 20):
-            angle = mpmath.pi / (2 * size)
-            table = [(int(mpmath.nint(mpmath.ldexp(mpmath.cos(angle * e), self.bits))),
-                      int(mpmath.nint(mpmath.ldexp(mpmath.sin(angle * e), self.bits)))) for e in range(period)]
+        with gmpy2.context(precision=self.bits + 20):
+            angle = gmpy2.const_pi() / (2 * size)
+            table = []
+            for e in range(period):
+                sine, cosine = gmpy2.sin_cos(angle * e)
+                table.append((gmpy2.mpz(gmpy2.mul_2exp(cosine, self.bits)), gmpy2.mpz(gmpy2.mul_2exp(sine, self.bits))))
         square = [(k * k) % period for k in range(size)]
-        self._square = [table[e] for e in square]  # w^{k²}
-        self._square_linear = [table[(e + k) % period] for k, e in enumerate(square)]  # w^{k + k²}
+        # w^{k²} and w^{k + k²}, real and imaginary parts
+        self._square = tuple(_array(part) for part in zip(*[table[e] for e in square]))
+        self._square_linear = tuple(_array(part) for part in zip(*[table[(e + k) % period] for k, e in enumerate(square)]))
         # the chirp w^{−m²}, m = −(M−1) … M−1, as the real, imaginary and summed parts of the Karatsuba products
         chirp = [table[(-(m * m)) % period] for m in range(-(size - 1), size)]
         # digits of the packed convolutions: |g| < 2^(bits+1), |chirp| < 2^(bits+1), M terms, a sign
@@ -104,29 +127,25 @@ class _FixedPointTransform:
         half = 1 << (self._width - 1)
         self._half, self._lift = half, gmpy2.pack([half] * (3 * size - 2), self._width)  # signed digits read back
 
-    def apply(self, values: Sequence[Any], transposed: bool = False) -> list[Any]:
+    def apply(self, values: np.ndarray, transposed: bool = False) -> np.ndarray:
         size, bits = self.size, self.bits
-        largest = max((abs(v) for v in values), default=0)
+        largest = max(abs(v) for v in values)
         if not largest:
-            return [mpmath.mpf(0)] * len(values)
-        shift = bits - mpmath.frexp(largest)[1]
-        x = [to_int(mpf_shift(mpmath.mpf(v)._mpf_, shift), "n") for v in values]
-        before, after = (self._square_linear, self._square) if transposed else (self._square, self._square_linear)
-        real = [(v * c) >> bits for v, (c, _) in zip(x, before)]
-        imaginary = [(v * s_) >> bits for v, (_, s_) in zip(x, before)]
-        summed = [r + i for r, i in zip(real, imaginary)]
+            return np.full(len(values), gmpy2.mpfr(0), dtype=object)
+        shift = bits - gmpy2.get_exp(largest)
+        scale = _TWO**shift  # a power of two: exact
+        x = _array([gmpy2.mpz(v * scale) for v in values])
+        (c, s_), (c_after, s_after) = (self._square_linear, self._square) if transposed else (self._square, self._square_linear)
+        real = (x * c) >> bits
+        imaginary = (x * s_) >> bits
         width, half = self._width, self._half
         products = []
-        for g, chirp in zip((real, imaginary, summed), self._chirp):
+        for g, chirp in zip((real, imaginary, real + imaginary), self._chirp):
             digits = gmpy2.unpack(_pack(g, width) * chirp + self._lift, width)
-            products.append([digit - half for digit in digits[size - 1:2 * size - 1]])
+            products.append(_array(digits[size - 1:2 * size - 1]) - half)
         first, second, third = products
-        result = []
-        for k in range(size):
-            z_real, z_imaginary = first[k] - second[k], third[k] - first[k] - second[k]
-            c, s_ = after[k]
-            result.append(mpmath.mpf((int(c * z_real - s_ * z_imaginary), -2 * bits - shift)))
-        return result
+        z_real, z_imaginary = first - second, third - first - second
+        return (c_after * z_real - s_after * z_imaginary) * _TWO ** (-2 * bits - shift)
 
 
 class FloatArc:
@@ -196,18 +215,29 @@ class VectorArc:
         self.mode = mode
         self._working = digits + _GUARD_DIGITS
         with workdps(self._working):
+            self._precision = mpmath.mp.prec
             self.ratios = [mpmath.mpf(r) for r in ratios]
-            self.coupling = [mpmath.mpf(c) for c in coupling]
-            self.forcing = [mpmath.mpf(g) for g in forcing]
             self.kappa = mpmath.mpf(kappa)
-            self.coefficient = mpmath.mpf(coefficient) if exponent is not None else mpmath.mpf(0)
             self.beta = mpmath.acos(self.kappa)
-            load, rank_one, elements = polynomial
-            self._load = [mpmath.mpf(x) for x in load]
-            self._rank_one = [([mpmath.mpf(x) for x in g], [mpmath.mpf(x) for x in c]) for g, c in rank_one]
-            self._elements = [([mpmath.mpf(x) for x in g], [mpmath.mpf(x) for x in c],
-                               [(m, mpmath.mpf(value)) for m, value in powers]) for g, c, powers in elements]
-            self._analytic = [([mpmath.mpf(x) for x in g], [mpmath.mpf(x) for x in c], law) for g, c, law in analytic]
+            with self._context():
+                def vector(values: Sequence[Any]) -> np.ndarray:
+                    return _array([_mpfr(x) for x in values])
+
+                self._beta = _mpfr(self.beta)
+                self._omega = [self._beta * _mpfr(r) for r in self.ratios]  # β r_k
+                self.coupling = vector(coupling)
+                self.forcing = vector(forcing)
+                self.coefficient = _mpfr(coefficient) if exponent is not None else gmpy2.mpfr(0)
+                load, rank_one, elements = polynomial
+                self._load = vector(load)
+                self._rank_one = [(vector(g), vector(c)) for g, c in rank_one]
+                self._elements = [(vector(g), vector(c), [(m, _mpfr(value)) for m, value in powers])
+                                  for g, c, powers in elements]
+                self._analytic = [(vector(g), vector(c), law) for g, c, law in analytic]
+        # every projection c·Y_n the laws read (memoised per vector and order when Y_n is fixed; the node values
+        # of the components themselves are not kept)
+        self._vectors = [self.coupling] + [c for _, c in self._rank_one] + [c for _, c, _ in self._elements] \
+            + [c for _, c, _ in self._analytic]
         self._analytic_terms: list[list[Callable[[Any], Any]]] = [[] for _ in self._analytic]  # f^{(k)}/k!
         self.size = len(self.ratios)
         self._fixed: list[tuple[list[Any], Any]] = []  # (h_k, μ_n) of orders 1, 2, …
@@ -220,67 +250,75 @@ class VectorArc:
         self._reset()
         self.counters = {"orders": 0, "restarts": 0}
 
+    def _context(self) -> Any:
+        """gmpy2 arithmetic at mpmath's working precision (the node arithmetic: numpy object arrays of mpfr)."""
+        return gmpy2.context(precision=self._precision)
+
     # -- grid -------------------------------------------------------------------------------------------
     def _reset(self) -> None:
         M, d = self.nodes, self.denominator
-        with workdps(self._working):
-            beta = self.beta
-            angles = [mpmath.pi * (i + mpmath.mpf(1) / 2) / M for i in range(M)]
-            self._v = [(mpmath.cos(angle) + 1) / 2 for angle in angles]
-            self._tau = [1 - v**d for v in self._v]
-            self._trig = [([mpmath.cos(beta * r * t) for t in self._tau], [mpmath.sin(beta * r * t) for t in self._tau])
-                          for r in self.ratios]
+        with self._context():
+            beta = self._beta
+            pi = gmpy2.const_pi()
+            self._v = _array([(gmpy2.cos(pi * (2 * i + 1) / (2 * M)) + 1) / 2 for i in range(M)])
+            power = self._v**d  # 1 − τ
+            self._tau = 1 - power
+            self._trig = []
+            for omega in self._omega:
+                pairs = [gmpy2.sin_cos(omega * t) for t in self._tau]
+                self._trig.append((_array([c for _, c in pairs]), _array([s for s, _ in pairs])))
             # cos βτ − cos β = 2 sin(β(1 + τ)/2) sin(β v^d/2), without cancellation near τ = 1
-            self._gap = [2 * mpmath.sin(beta * (1 + t) / 2) * mpmath.sin(beta * v**d / 2) for t, v in zip(self._tau, self._v)]
-            self._weight = [self.coefficient * g**self.exponent for g in self._gap] if self.exponent is not None \
-                else [mpmath.mpf(0)] * M
-            self._jacobian = [d * v ** (d - 1) for v in self._v]  # −dt/dν
+            self._gap = _array([2 * gmpy2.sin(beta * (1 + t) / 2) * gmpy2.sin(beta * w / 2)
+                                for t, w in zip(self._tau, power)])
+            self._zero = np.full(M, gmpy2.mpfr(0), dtype=object)
+            if self.exponent is not None:
+                p = gmpy2.mpfr(self.exponent.numerator) / self.exponent.denominator
+                self._weight = self.coefficient * _array([g**p for g in self._gap])
+            self._jacobian = d * self._v ** (d - 1) if d > 1 else None  # −dt/dν
             self._fast = _FixedPointTransform(M, self._working)
-            zero = [mpmath.mpf(0)] * M
             cosine = self._trig[self.mode][0]
-            self._values = [[list(cosine) if k == self.mode else list(zero) for k in range(self.size)]]  # Y_n at the nodes
-            self._second = [[[-beta * beta * c for c in cosine] if k == self.mode else list(zero) for k in range(self.size)]]
-            self._ratios_r: list[list[Any]] = [[]]  # R_n (n ≥ 1)
-            self._binomial = [[mpmath.mpf(1)] * M]  # B_n of (1 + Σ R ε̂)^p
+            self._second: list[list[np.ndarray] | None] = [None]  # Y_n'' per component (order 0 is never read)
+            self._slopes: list[list[np.ndarray]] = []  # dY_n/dτ per component at the nodes (their series on demand)
+            self._slope_series: dict[tuple[int, int], list[Any]] = {}
+            self._ratios_r: list[np.ndarray | None] = [None]  # R_n (n ≥ 1)
+            self._binomial = [np.full(M, gmpy2.mpfr(1), dtype=object)]  # B_n of (1 + Σ R ε̂)^p
             self._mu = [1 / (beta * beta)]
-            self._powers: dict[tuple, list[Any]] = {}  # [(c·Y)^m]_n, [(y − y_0)^m]_n at the nodes
-            self._taylor: dict[tuple[int, int], list[Any]] = {}  # f^{(k)}(y_0)/k! of an analytic law at the nodes
-            self._series: list[list[tuple[list[Any], list[Any]]]] = []  # Chebyshev coefficients of Y_{n,k}, Y_{n,k}'
-            self.tail = mpmath.mpf(0)
+            self._projections = {(id(vector), 0): vector[self.mode] * cosine for vector in self._vectors}
+            self._powers: dict[tuple, np.ndarray] = {}  # [(c·Y)^m]_n, [(y − y_0)^m]_n at the nodes
+            self._taylor: dict[tuple[int, int], np.ndarray] = {}  # f^{(k)}(y_0)/k! of an analytic law at the nodes
+            self._series: list[list[np.ndarray]] = []  # Chebyshev coefficients of Y_{n,k}
+            self.tail = gmpy2.mpfr(0)
 
-    def _coefficients(self, values: list[Any]) -> list[Any]:
+    def _coefficients(self, values: np.ndarray) -> np.ndarray:
         """Chebyshev coefficients a_k (a_0 halved) of the interpolant through the node values."""
-        M = self.nodes
-        scale = mpmath.mpf(2) / M
-        coefficients = [scale * c for c in self._fast.apply(values)]
+        coefficients = self._fast.apply(values) * (gmpy2.mpfr(2) / self.nodes)
         coefficients[0] /= 2
         return coefficients
 
-    def _integral_to_end(self, integrand: list[Any]) -> tuple[list[Any], Any]:
-        """∫_v^1 h(ν) dν at every node and ∫_0^1 h: cumulative Chebyshev integration in x = 2ν − 1."""
+    def _integral_to_end(self, integrand: np.ndarray) -> tuple[np.ndarray, Any, np.ndarray]:
+        """∫_v^1 h(ν) dν at every node, ∫_0^1 h, and h's Chebyshev coefficients: cumulative Chebyshev integration in
+        x = 2ν − 1."""
         M = self.nodes
-        a = self._coefficients(integrand) + [mpmath.mpf(0), mpmath.mpf(0)]
-        b = [mpmath.mpf(0)] * (M + 1)
+        coefficients = self._coefficients(integrand)
+        a = np.concatenate([coefficients, self._zero[:2]])
+        b = np.empty(M + 1, dtype=object)
+        b[0] = gmpy2.mpfr(0)
         b[1] = a[0] - a[2] / 2
-        for k in range(2, M + 1):
-            b[k] = (a[k - 1] - a[k + 1]) / (2 * k)
-        top = mpmath.fsum(b)
-        bottom = mpmath.fsum(value if k % 2 == 0 else -value for k, value in enumerate(b))
+        b[2:] = (a[1:M] - a[3:M + 2]) / (2 * np.arange(2, M + 1))
+        top = b.sum()
+        bottom = b[0::2].sum() - b[1::2].sum()
         # T_M(x_i) = cos(M θ_i) = 0 at first-kind nodes: Σ_{k<M} b_k T_k(x_i), the transposed transform
-        at_nodes = [(top - value) / 2 for value in self._fast.apply(b[:M], transposed=True)]
-        return at_nodes, (top - bottom) / 2
+        at_nodes = (top - self._fast.apply(b[:M], transposed=True)) / 2
+        return at_nodes, (top - bottom) / 2, coefficients
 
     # -- the law on the arc -----------------------------------------------------------------------------
-    def _projection(self, vector: Sequence[Any], order: int) -> list[Any]:
-        """vector · Y_order at the nodes (memoised per vector and order: every component's law reads the same
-        projections — recomputing them per component made the N-dof arc O(N²) per order)."""
-        key = ("projection", id(vector), order)
-        if key not in self._powers:
-            values = self._values[order]
-            self._powers[key] = [mpmath.fsum(w * values[k][i] for k, w in enumerate(vector) if w) for i in range(self.nodes)]
-        return self._powers[key]
+    def _projection(self, vector: np.ndarray, order: int) -> np.ndarray:
+        """vector · Y_order at the nodes (computed for every vector of the laws when Y_order is fixed: every
+        component's law reads the same projections — recomputing them per component made the N-dof arc O(N²) per
+        order)."""
+        return self._projections[(id(vector), order)]
 
-    def _power(self, element: int, power: int, order: int) -> list[Any]:
+    def _power(self, element: int, power: int, order: int) -> np.ndarray:
         """[(c_e · Y)^power]_order at the nodes."""
         key = (element, power, order)
         if key not in self._powers:
@@ -288,14 +326,12 @@ class VectorArc:
             if power == 1:
                 result = self._projection(coupling, order)
             else:
-                result = [mpmath.mpf(0)] * self.nodes
-                for i in range(order + 1):
-                    left, right = self._power(element, power - 1, i), self._power(element, 1, order - i)
-                    result = [r + x * y for r, x, y in zip(result, left, right)]
+                result = sum((self._power(element, power - 1, i) * self._power(element, 1, order - i)
+                              for i in range(order + 1)), self._zero)
             self._powers[key] = result
         return self._powers[key]
 
-    def _taylor_values(self, element: int, k: int) -> list[Any]:
+    def _taylor_values(self, element: int, k: int) -> np.ndarray:
         """f^{(k)}(y_0)/k! at the nodes for the analytic law ``element``, y_0 = c · Y_0."""
         key = (element, k)
         if key not in self._taylor:
@@ -305,72 +341,66 @@ class VectorArc:
                 derivative = sympy.diff(expression, symbol, len(terms))
                 scale = sympy.Integer(math.factorial(len(terms)))
                 terms.append(sympy.lambdify(symbol, derivative / scale, modules="mpmath"))
-            values = [mpmath.mpf(terms[k](y)) for y in self._projection(coupling, 0)]
+            values = [mpmath.mpf(terms[k](_mpf(y))) for y in self._projection(coupling, 0)]
             if not all(mpmath.isfinite(value) for value in values):
                 raise UnsupportedNonlinearityError(
                     f"the law {expression} is not analytic on the contact arc (derivative {k} is not finite there)")
-            self._taylor[key] = values
+            self._taylor[key] = _array([_mpfr(value) for value in values])
         return self._taylor[key]
 
-    def _deviation(self, element: int, power: int, order: int) -> list[Any]:
+    def _deviation(self, element: int, power: int, order: int) -> np.ndarray:
         """[(y − y_0)^power]_order at the nodes for the analytic law ``element``, y = c · Y (1 ≤ power ≤ order)."""
         key = ("deviation", element, power, order)
         if key not in self._powers:
             if power == 1:
                 result = self._projection(self._analytic[element][1], order)
             else:
-                result = [mpmath.mpf(0)] * self.nodes
-                for j in range(1, order - power + 2):
-                    left, right = self._deviation(element, 1, j), self._deviation(element, power - 1, order - j)
-                    result = [r + x * y for r, x, y in zip(result, left, right)]
+                result = sum((self._deviation(element, 1, j) * self._deviation(element, power - 1, order - j)
+                              for j in range(1, order - power + 2)), self._zero)
             self._powers[key] = result
         return self._powers[key]
 
-    def _law(self, order: int, k: int) -> list[Any]:
-        """[F_k(Y)]_order at the nodes."""
-        M = self.nodes
-        total = [self.forcing[k] * self._weight[i] * self._binomial[order][i] for i in range(M)] if self.forcing[k] \
-            else [mpmath.mpf(0)] * M
-        if order == 0 and self._load[k]:
-            total = [t + self._load[k] for t in total]
+    def _law_terms(self, order: int) -> list[tuple[np.ndarray, np.ndarray]]:
+        """[F(Y)]_order as pairs (per-component weights g, node values): [F_k(Y)]_order = Σ g_k values."""
+        terms = []
+        if self.exponent is not None:
+            terms.append((self.forcing, self._weight * self._binomial[order]))
         for g, c in self._rank_one:
-            if g[k]:
-                projection = self._projection(c, order)
-                total = [t + g[k] * y for t, y in zip(total, projection)]
+            terms.append((g, self._projection(c, order)))
         for element, (g, _, powers) in enumerate(self._elements):
-            if g[k]:
-                for power, value in powers:
-                    term = self._power(element, power, order)
-                    total = [t + g[k] * value * y for t, y in zip(total, term)]
+            for power, value in powers:
+                terms.append((g, value * self._power(element, power, order)))
         for element, (g, _, _) in enumerate(self._analytic):
-            if g[k]:
-                if order == 0:
-                    total = [t + g[k] * f for t, f in zip(total, self._taylor_values(element, 0))]
-                for power in range(1, order + 1):
-                    term = self._deviation(element, power, order)
-                    total = [t + g[k] * f * y for t, f, y in zip(total, self._taylor_values(element, power), term)]
-        return total
+            if order == 0:
+                terms.append((g, self._taylor_values(element, 0)))
+            for power in range(1, order + 1):
+                terms.append((g, self._taylor_values(element, power) * self._deviation(element, power, order)))
+        return terms
 
     # -- the hierarchy ----------------------------------------------------------------------------------
     def _particular(self, order: int) -> list[dict]:
         """Per component: the forcing without μ_order, P_k at the nodes and P_k(1), P_k'(1)."""
-        beta = self.beta
+        beta2 = self._beta * self._beta
+        terms = self._law_terms(order - 1)
+        mus = [beta2 * self._mu[i] for i in range(1, order)]
         out = []
         for k in range(self.size):
-            law = self._law(order - 1, k)
-            forcing = [-beta * beta * value for value in law]
-            for i in range(1, order):
-                mu = self._mu[i]
-                forcing = [g - beta * beta * mu * y for g, y in zip(forcing, self._second[order - i][k])]
+            law = self._zero
+            for g, values in terms:
+                if g[k]:
+                    law = law + g[k] * values
+            if order == 1 and self._load[k]:
+                law = law + self._load[k]
+            forcing = law * -beta2
+            for i, mu in enumerate(mus, start=1):
+                forcing = forcing - mu * self._second[order - i][k]
             cosine, sine = self._trig[k]
-            integrand_cos = [j * c * g for j, c, g in zip(self._jacobian, cosine, forcing)]
-            integrand_sin = [j * s * g for j, s, g in zip(self._jacobian, sine, forcing)]
-            cos_integral, cos_total = self._integral_to_end(integrand_cos)
-            sin_integral, sin_total = self._integral_to_end(integrand_sin)
-            omega = beta * self.ratios[k]
-            end_cos, end_sin = mpmath.cos(omega), mpmath.sin(omega)
-            coefficients = self._coefficients(integrand_cos)
-            scale = max(abs(a) for a in coefficients) or mpmath.mpf(1)
+            weighted = forcing if self._jacobian is None else self._jacobian * forcing
+            cos_integral, cos_total, coefficients = self._integral_to_end(cosine * weighted)
+            sin_integral, sin_total, _ = self._integral_to_end(sine * weighted)
+            omega = self._omega[k]
+            end_sin, end_cos = gmpy2.sin_cos(omega)
+            scale = max(abs(a) for a in coefficients) or gmpy2.mpfr(1)
             out.append({
                 "forcing": forcing, "cos": cos_integral, "sin": sin_integral,
                 "end": (end_sin * cos_total - end_cos * sin_total) / omega,
@@ -380,45 +410,47 @@ class VectorArc:
         return out
 
     def _solve(self, order: int, release: list[Any], mu: Any, data: list[dict]) -> None:
-        beta = self.beta
-        resonant = beta**3 / 2
-        values_all, second_all, series = [], [], []
+        beta = self._beta
+        resonant = beta**3 / 2 * mu
+        values_all, second_all, slopes_all, series = [], [], [], []
         for k in range(self.size):
             cosine, sine = self._trig[k]
-            omega = beta * self.ratios[k]
+            omega = self._omega[k]
             item = data[k]
-            values, slopes, second = [], [], []
-            for i in range(self.nodes):
-                c, s, t = cosine[i], sine[i], self._tau[i]
-                value = release[k] * c + (s * item["cos"][i] - c * item["sin"][i]) / omega
-                slope = -release[k] * omega * s + c * item["cos"][i] + s * item["sin"][i]
-                force = item["forcing"][i]
-                if k == self.mode:
-                    value += resonant * mu * t * s
-                    slope += resonant * mu * (s + beta * t * c)
-                    force += beta**4 * mu * c
-                values.append(value)
-                slopes.append(slope)
-                second.append(force - omega * omega * value)
+            values = (sine * item["cos"] - cosine * item["sin"]) / omega
+            slopes = cosine * item["cos"] + sine * item["sin"]
+            force = item["forcing"]
+            if release[k]:
+                values = values + release[k] * cosine
+                slopes = slopes - (release[k] * omega) * sine
+            if k == self.mode:
+                values = values + resonant * (self._tau * sine)
+                slopes = slopes + resonant * (sine + beta * (self._tau * cosine))
+                force = force + (beta**4 * mu) * cosine
             values_all.append(values)
-            second_all.append(second)
+            second_all.append(force - (omega * omega) * values)
+            slopes_all.append(slopes)
             value_series = self._coefficients(values)
-            series.append((value_series, self._coefficients(slopes)))
+            series.append(value_series)
             size = max(abs(a) for a in value_series)
             if size:
                 self.tail = max(self.tail, max(abs(a) for a in value_series[-4:]) / size)
-        self._values.append(values_all)
+        stacked = np.vstack(values_all)
+        for vector in self._vectors:
+            key = (id(vector), order)
+            if key not in self._projections:
+                self._projections[key] = vector.dot(stacked)
         self._second.append(second_all)
-        chi_j = self.coupling[self.mode]
+        self._slopes.append(slopes_all)
         deformation = self._projection(self.coupling, order)
-        self._ratios_r.append([z / (chi_j * g) for z, g in zip(deformation, self._gap)])
+        self._ratios_r.append(deformation / (self.coupling[self.mode] * self._gap))
         if self.exponent is None:
-            self._binomial.append([mpmath.mpf(0)] * self.nodes)
+            self._binomial.append(self._zero)
         else:
-            p = mpmath.mpf(self.exponent.numerator) / self.exponent.denominator
+            p = gmpy2.mpfr(self.exponent.numerator) / self.exponent.denominator
             # B_n = (1/n) Σ_{k=1}^{n} ((p + 1) k − n) R_k B_{n−k}   (powers of 1 + Σ R_k ε̂^k)
-            self._binomial.append([mpmath.fsum(((p + 1) * k - order) * self._ratios_r[k][i] * self._binomial[order - k][i]
-                                               for k in range(1, order + 1)) / order for i in range(self.nodes)])
+            self._binomial.append(sum((((p + 1) * k - order) * (self._ratios_r[k] * self._binomial[order - k])
+                                       for k in range(1, order + 1)), self._zero) / order)
         self._mu.append(mu)
         self._series.append(series)
 
@@ -427,14 +459,14 @@ class VectorArc:
         if 2 * self.nodes > _MAXIMUM_NODES:
             raise ConvergenceError(
                 f"the stretched contact arc needs more than {_MAXIMUM_NODES} Chebyshev points "
-                f"for {self.digits} digits at order {order} (tail {mpmath.nstr(self.tail, 3)}); "
+                f"for {self.digits} digits at order {order} (tail {float(self.tail):.3g}); "
                 "ask for fewer digits or a lower order")
         self.nodes *= 2
         self.counters["restarts"] += 1
         self._reset()
         for n, (release, mu) in enumerate(self._fixed, start=1):
-            with workdps(self._working):
-                self._solve(n, release, mu, self._particular(n))
+            with workdps(self._working), self._context():
+                self._solve(n, [_mpfr(h) for h in release], _mpfr(mu), self._particular(n))
 
     @locked
     def response(self, order: int) -> list[tuple[Any, Any]]:
@@ -445,15 +477,14 @@ class VectorArc:
         """
         if order != len(self._mu):
             raise ValueError(f"order {order} of the stretched arc is not the next one ({len(self._mu)})")
-        tolerance = mpmath.mpf(10) ** (-(self.digits + 2))
         while True:  # the grid doubles until this order's forcing and the fixed orders are resolved
-            with workdps(self._working):
+            with workdps(self._working), self._context():
+                tolerance = gmpy2.mpfr(10) ** (-(self.digits + 2))
                 data = self._particular(order)
-            if max(max(item["tail"] for item in data), self.tail) <= tolerance:
-                break
+                if max(max(item["tail"] for item in data), self.tail) <= tolerance:
+                    self._pending = (order, data)
+                    return [(_mpf(item["end"]), _mpf(item["end_slope"])) for item in data]
             self._refine(order)
-        self._pending = (order, data)
-        return [(item["end"], item["end_slope"]) for item in data]
 
     @locked
     def end_terms(self, k: int) -> tuple[Any, Any, Any, Any]:
@@ -470,10 +501,10 @@ class VectorArc:
         """Complete Y_order with its release values h_k = Y_{order,k}(0) and μ_order."""
         if self._pending is None or self._pending[0] != order:
             self.response(order)
-        with workdps(self._working):
+        with workdps(self._working), self._context():
             release = [mpmath.mpf(h) for h in release]
             mu = mpmath.mpf(mu)
-            self._solve(order, release, mu, self._pending[1])
+            self._solve(order, [_mpfr(h) for h in release], _mpfr(mu), self._pending[1])
         self._fixed.append((release, mu))
         self._pending = None
         self.counters["orders"] += 1
@@ -481,7 +512,12 @@ class VectorArc:
     @locked
     def mu(self, order: int) -> Any:
         """μ_order (fixed orders only)."""
-        return self._mu[order]
+        if order >= len(self._mu):
+            raise IndexError(f"μ_{order} of the stretched arc is not fixed yet")
+        if order:
+            return self._fixed[order - 1][1]
+        with workdps(self._working):
+            return 1 / (self.beta * self.beta)
 
     @locked
     def release(self, order: int, component: int) -> Any:
@@ -493,14 +529,18 @@ class VectorArc:
         """Chebyshev coefficients (in x = 2v − 1) of Y_{order,component} and of its τ-derivative (fixed orders only)."""
         if len(self._mu) <= order:
             raise ValueError(f"order {order} of the stretched arc is not fixed yet")
-        if order:
-            return self._series[order - 1][component]
-        with workdps(self._working):  # Y_0 = e_j cos βτ and its τ-slope, interpolated on the same grid
-            on = component == self.mode
-            cosine, sine = self._trig[component]
-            omega = self.beta * self.ratios[component]
-            return (self._coefficients([c if on else mpmath.mpf(0) for c in cosine]),
-                    self._coefficients([-omega * s if on else mpmath.mpf(0) for s in sine]))
+        with workdps(self._working), self._context():
+            if order:
+                key = (order, component)
+                if key not in self._slope_series:
+                    self._slope_series[key] = self._coefficients(self._slopes[order - 1][component])
+                values, slopes = self._series[order - 1][component], self._slope_series[key]
+            else:  # Y_0 = e_j cos βτ and its τ-slope, interpolated on the same grid
+                cosine, sine = self._trig[component]
+                on = component == self.mode
+                values = self._coefficients(cosine if on else self._zero)
+                slopes = self._coefficients(-self._omega[component] * sine if on else self._zero)
+            return [_mpf(a) for a in values], [_mpf(a) for a in slopes]
 
     @locked
     def float_arcs(self, highest: int) -> tuple[FloatArc, ...]:
