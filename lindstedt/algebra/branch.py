@@ -221,6 +221,8 @@ class EvaluationPoint:
         self._sin = [domain.zero, sine]
         self._powers = [domain.one]
         self._cache: dict[Any, tuple[Any, Any]] = {}
+        # per term key (j, parity, m): (s0^m, cos(j s0) or sin(j s0)), the factors of a term's value there
+        self._factors: dict[TermKey, tuple[Any, Any]] = {}
 
     # The tables only grow, an entry appended complete (cos before sin): a length that covers an index
     # means its entries are final, so reads need no lock; growing takes it (points are shared by threads).
@@ -255,6 +257,15 @@ class EvaluationPoint:
             self._extend(harmonic)
             return self._sin[harmonic]
         return self._transcendental(harmonic)[1]
+
+    def factors(self, key: TermKey) -> tuple[Any, Any]:
+        """(s0^m, cos(j s0)) or (s0^m, sin(j s0)) for the term key (j, parity, m), remembered."""
+        pair = self._factors.get(key)
+        if pair is None:
+            harmonic, parity, power = key
+            pair = (self.power(power), self.cos_multiple(harmonic) if parity == 0 else self.sin_multiple(harmonic))
+            self._factors[key] = pair  # complete when stored: readers need no lock
+        return pair
 
     def _transcendental(self, frequency: Any) -> tuple[Any, Any]:
         context = getattr(self.value, "context", None)
@@ -317,7 +328,10 @@ class Branch:
         return Branch(self.domain, {key: -value for key, value in self.terms.items()})
 
     def __sub__(self, other: "Branch") -> "Branch":
-        return self + (-other)
+        result = dict(self.terms)
+        for key, value in other.terms.items():
+            _add_into(result, key, -value)
+        return Branch(self.domain, result)
 
     def scale(self, factor: Any) -> "Branch":
         """Multiply by the domain element ``factor``."""
@@ -341,7 +355,9 @@ class Branch:
         for (harmonic, parity, power), value in self.terms.items():
             if power:
                 _add_into(result, (harmonic, parity, power - 1), value * convert(power))
-            if harmonic:
+            if harmonic.__class__ is int and harmonic == 1:  # multiplying by 1 changes nothing (not even a rounding)
+                _add_into(result, (1, 1 - parity, power), value if parity else -value)
+            elif harmonic:
                 factor = convert(harmonic) if isinstance(harmonic, int) else harmonic
                 _add_into(result, (harmonic, 1 - parity, power), value * factor if parity else -(value * factor))
         return Branch(self.domain, result)
@@ -426,10 +442,11 @@ class Branch:
         if cached is not None:
             return cached
         triples = []
-        for (harmonic, parity, power), value in self.terms.items():
-            trig = point.cos_multiple(harmonic) if parity == 0 else point.sin_multiple(harmonic)
-            if trig:
-                triples.append((value, point.power(power), trig))
+        known, factors = point._factors, point.factors
+        for key, value in self.terms.items():
+            pair = known.get(key) or factors(key)
+            if pair[1]:
+                triples.append((value, pair[0], pair[1]))
         total = sum_of_products(self.domain, triples)
         self._values[point] = total
         return total

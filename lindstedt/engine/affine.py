@@ -44,6 +44,8 @@ class _Affine:
         return _Affine((base - subtracted if base else -subtracted) if subtracted else base, terms)
 
     def scale(self, factor: Any) -> "_Affine":
+        if not factor:
+            return _Affine(factor, {})
         base = self.base
         return _Affine(base * factor if base else base, {index: value * factor for index, value in self.terms.items()})
 

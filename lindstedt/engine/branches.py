@@ -52,6 +52,7 @@ Coefficients live in any sympy field: exact (``QQ``, ``QQ(π, κ, β, …)``) or
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, Sequence
 
@@ -163,6 +164,17 @@ def _combination(domain: Any, branches: Sequence[Branch], weights: Sequence[Any]
     return Branch(domain, terms)
 
 
+def _subtract(terms: dict, branch: Branch, factor: Any = None) -> None:
+    """terms −= factor · branch in place (the terms ``rhs - branch.scale(factor)`` holds, zeros kept: 0 + x is x)."""
+    if factor is None:
+        for key, value in branch.terms.items():
+            terms[key] = terms[key] + -value if key in terms else -value
+    elif factor:
+        for key, value in branch.terms.items():
+            value = -(value * factor)
+            terms[key] = terms[key] + value if key in terms else value
+
+
 class BranchHierarchy(LazyOrders):
     """Order-by-order solution of a :class:`BranchSystem` (see the module docstring).
 
@@ -216,6 +228,7 @@ class BranchHierarchy(LazyOrders):
         self._pending: dict[int, list[int]] = {}
         self._gap_parts: dict[int, list[Any]] = {}
         self._projection_cache: dict[tuple[int, int], list[Branch]] = {}
+        self._inverse_factorials: list[Any] = [domain.one, domain.one]
 
     # -- read access ---------------------------------------------------------------------------------
     @locked
@@ -347,15 +360,20 @@ class BranchHierarchy(LazyOrders):
         point = self.system.boundaries[boundary].point
         domain = self._domain
         terms = []
-        factorial = 1
         for times in range(1, order + 1):
-            factorial *= times
-            inverse = domain_constant(domain, QQ(1, factorial))
+            inverse = self._inverse_factorial(times)
             for j in range(0, order - times + 1):
                 weight = powers[times][order - j]
                 if weight:
                     terms.append((self._derivative(j, piece, component, times + derivative).evaluate(point), weight, inverse))
         return sum_of_products(domain, terms)
+
+    def _inverse_factorial(self, n: int) -> Any:
+        """1/n! in the domain (its one for n ≤ 1: a product with it is skipped by a fused sum of products)."""
+        table = self._inverse_factorials
+        while len(table) <= n:
+            table.append(domain_constant(self._domain, QQ(1, math.factorial(len(table)))))
+        return table[n]
 
     def _boundary_first_harmonic(self, boundary: int, order: int, powers: list[list[Any]]) -> Any:
         """ε̂^order coefficient of ∫_β^{s*} (W_j^p − W_j^{p+1}) cos s ds (known part)."""
@@ -444,48 +462,59 @@ class BranchHierarchy(LazyOrders):
             projections = self._projections(order, piece, state, previous) if state.rank_one and previous else []
             components_rhs = []
             for k in components:
-                rhs = Branch(domain)
+                rhs: dict = {}  # the right-hand side's terms, each part subtracted in turn (zeros dropped at the end)
                 for i in range(1, order):
-                    rhs = rhs - self._derivative(order - i, piece, k, 2).scale(self._squared[i])
+                    _subtract(rhs, self._derivative(order - i, piece, k, 2), self._squared[i])
                 for l, entry in enumerate(state.stiffness[k] if state.stiffness and previous else ()):
                     if entry:
-                        rhs = rhs - previous[l].scale(entry)
+                        _subtract(rhs, previous[l], entry)
                 if projections:
-                    rhs = rhs - _combination(domain, projections, [forcing[k] for forcing, _ in state.rank_one])
+                    _subtract(rhs, _combination(domain, projections, [forcing[k] for forcing, _ in state.rank_one]))
                 if order == system.gauge and state.load[k]:
-                    rhs = rhs - Branch.constant(domain, state.load[k])
+                    _subtract(rhs, Branch.constant(domain, state.load[k]))
                 if order >= system.gauge:
                     for element, (forcing, _, _) in enumerate(state.analytic):
                         if forcing[k]:
-                            rhs = rhs - self._analytic_force(piece, element, order - system.gauge).scale(forcing[k])
+                            _subtract(rhs, self._analytic_force(piece, element, order - system.gauge), forcing[k])
                     for element, (forcing, _, powers) in enumerate(state.elements):
                         if forcing[k]:
                             for power, coefficient in powers:
-                                rhs = rhs - self._law_power(piece, element, power, order - system.gauge).scale(
-                                    coefficient * forcing[k])
-                components_rhs.append(rhs.oscillator_particular_solution(system.ratios[k]))
+                                _subtract(rhs, self._law_power(piece, element, power, order - system.gauge),
+                                          coefficient * forcing[k])
+                components_rhs.append(Branch(domain, rhs).oscillator_particular_solution(system.ratios[k]))
             particular.append(components_rhs)
 
         # the particular solutions' slopes, each formed once per order (they are evaluated at every boundary)
         particular_slopes = [[branch.derivative() for branch in pieces] for pieces in particular]
         ratios = self._ratio_elements
 
-        def value_of(piece: int, position: int, c: _Affine, d: _Affine, point: EvaluationPoint, slope: bool) -> _Affine:
-            """W_{n,k}^piece (or its slope) at point, for homogeneous parts c, d (k = components[position])."""
+        def value_of(piece: int, position: int, c: _Affine | None, d: _Affine | None, point: EvaluationPoint,
+                     slope: bool) -> _Affine:
+            """W_{n,k}^piece (or its slope) at point, for homogeneous parts c, d (k = components[position]; None: zero)."""
             k = components[position]
+            branch = particular_slopes[piece][position] if slope else particular[piece][position]
+            result = _Affine(branch.evaluate(point),
+                             {0: (self._resonant_slope if slope else resonant).evaluate(point)} if k == mode else {})
+            if c is None and d is None:
+                return result
             frequency = system.frequency(k)
             cosine, sine = point.cos_multiple(frequency), point.sin_multiple(frequency)
-            branch = particular_slopes[piece][position] if slope else particular[piece][position]
-            result = constant(branch.evaluate(point))
-            if k == mode:
-                result = result + unit(0).scale((self._resonant_slope if slope else resonant).evaluate(point))
-            if slope:
-                return result + c.scale(-sine * ratios[k]) + d.scale(cosine * ratios[k])
-            return result + c.scale(cosine) + d.scale(sine)
+            if slope:  # r_k = 1 (the mode component) multiplies nothing
+                ratio = ratios[k]
+                cosine, sine = (cosine, -sine) if ratio is one else (cosine * ratio, -sine * ratio)
+                cosine, sine = sine, cosine  # c multiplies −r sin, d r cos
+            if c is not None:
+                result = result + c.scale(cosine)
+            return result if d is None else result + d.scale(sine)
+
+        def over_ratio(value: Any, k: int) -> Any:
+            """value / r_k (r_k = 1: value itself)."""
+            ratio = ratios[k]
+            return value if ratio is one else value / ratio
 
         # First piece: c_k free, d_k from W_k'(0) = 0 (d_k r_k + slope without d = 0).
         c_values = [[unit(1 + p) for p in range(size)]]
-        d_values = [[value_of(0, p, c_values[0][p], constant(zero), system.zero_point, True).scale(-one / ratios[k])
+        d_values = [[value_of(0, p, c_values[0][p], None, system.zero_point, True).scale(over_ratio(-one, k))
                      for p, k in enumerate(components)]]
         shift_values: list[_Affine | None] = []
         gaps: list[_Affine] = []
@@ -529,12 +558,12 @@ class BranchHierarchy(LazyOrders):
                 slope = value_of(left, p, c_values[left][p], d_values[left][p], point, True)
                 x = values[p].shift(known[p] - self._known(index, right, k, order, 0, powers))
                 y = slope.shift(self._known(index, left, k, order, 1, powers) - self._known(index, right, k, order, 1, powers))
-                x = x - value_of(right, p, constant(zero), constant(zero), point, False)
-                y = y - value_of(right, p, constant(zero), constant(zero), point, True)
+                x = x - value_of(right, p, None, None, point, False)
+                y = y - value_of(right, p, None, None, point, True)
                 frequency = system.frequency(k)
                 cosine, sine = point.cos_multiple(frequency), point.sin_multiple(frequency)
-                c_next.append(x.scale(cosine) - y.scale(sine / ratios[k]))
-                d_next.append(x.scale(sine) + y.scale(cosine / ratios[k]))
+                c_next.append(x.scale(cosine) - y.scale(over_ratio(sine, k)))
+                d_next.append(x.scale(sine) + y.scale(over_ratio(cosine, k)))
             c_values.append(c_next)
             d_values.append(d_next)
         last = last_piece
@@ -652,8 +681,8 @@ class BranchHierarchy(LazyOrders):
             if k == mode:  # W_0'(β) σ_n = −sin β σ_n, W_0''(β) σ_n = −cos β σ_n move to the targets
                 target = target + unit(1).scale(sine)
                 slope_target = slope_target + unit(1).scale(cosine)
-            x = target - value_of(1, k, constant(domain.zero), constant(domain.zero), point, False)
-            y = slope_target - value_of(1, k, constant(domain.zero), constant(domain.zero), point, True)
+            x = target - value_of(1, k, None, None, point, False)
+            y = slope_target - value_of(1, k, None, None, point, True)
             frequency, ratio = system.frequency(k), self._ratio_elements[k]
             cos_r, sin_r = point.cos_multiple(frequency), point.sin_multiple(frequency)
             c_next.append(x.scale(cos_r) - y.scale(sin_r / ratio))
