@@ -142,7 +142,7 @@ def _degree(f: sympy.Expr, variable: sympy.Symbol) -> int:
 def _at_origin(f: sympy.Expr, variable: sympy.Symbol) -> bool:
     """True when every switch of f turns at u = 0 (contact angle π/2: rational cosines, the cheapest algebra)."""
     arguments = [argument for atom in f.atoms(*_SWITCHES) for argument in atom.args if argument.has(variable)]
-    return bool(arguments) and not f.atoms(sympy.Piecewise) and all(argument.subs(variable, 0) == 0 for argument in arguments)
+    return bool(arguments) and not f.atoms(sympy.Piecewise) and all(argument.xreplace({variable: 0}) == 0 for argument in arguments)
 
 
 def _breakpoints(f: sympy.Expr, variable: sympy.Symbol) -> int:

@@ -73,6 +73,9 @@ def _undecidable(arguments: Sequence[sympy.Expr]) -> bool:
     itself a switch.  ``Max``/``Min`` of such arguments keeps every one of them: sympy's evaluation
     (``_collapse_arguments``, ``_find_localzeros``, which decide the pairwise orderings through the assumptions
     system, milliseconds per call) cannot remove any, and ``evaluate=False`` builds the same object."""
+    lines = [_rational_line(argument) for argument in arguments]
+    if all(line is not None for line in lines):  # r·u + c with rational r, c: decided by the slopes alone
+        return len({slope for slope, _ in lines}) == len(lines)
     if any(argument.has(sympy.Max, sympy.Min, sympy.Piecewise, sympy.oo, -sympy.oo, sympy.zoo, sympy.nan)
            for argument in arguments):
         return False
@@ -83,6 +86,22 @@ def _undecidable(arguments: Sequence[sympy.Expr]) -> bool:
             if rest != DISPLACEMENT or not factor.is_Rational or factor == 0 or constant.is_extended_real is not True:
                 return False
     return True
+
+
+def _rational_line(expression: sympy.Expr) -> tuple[Any, Any] | None:
+    """(r, c) when ``expression`` is r·u + c with rational r and c (read from its structure), else None."""
+    if expression.is_Rational:
+        return 0, expression
+    if expression == DISPLACEMENT:
+        return 1, 0
+    arguments = expression.args
+    if expression.is_Mul and len(arguments) == 2 and arguments[0].is_Rational and arguments[1] == DISPLACEMENT:
+        return arguments[0], 0
+    if expression.is_Add and len(arguments) == 2 and arguments[0].is_Rational:
+        line = _rational_line(arguments[1])
+        if line is not None and line[1] == 0 and line[0] != 0:
+            return line[0], arguments[0]
+    return None
 
 
 def substitute(expression: sympy.Expr, values: Mapping[sympy.Symbol, sympy.Expr]) -> sympy.Expr:
@@ -97,6 +116,8 @@ def substitute(expression: sympy.Expr, values: Mapping[sympy.Symbol, sympy.Expr]
     >>> substitute(f, {kappa: sympy.Rational(3, 10)}) == f.subs(kappa, sympy.Rational(3, 10))
     True
     """
+    if expression.is_Symbol:  # what subs does to a symbol
+        return values.get(expression, expression)
     if not values or not expression.free_symbols & set(values):
         return expression
     if isinstance(expression, (sympy.Max, sympy.Min)):
