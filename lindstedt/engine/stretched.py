@@ -90,62 +90,120 @@ def _array(values: Sequence[Any]) -> np.ndarray:
 
 
 class _FixedPointTransform:
-    """``y = T x`` (or ``Tᵀ x``) for the arc's Chebyshev matrix ``T_{k,i} = cos(k θ_i)``, ``θ_i = π (i + ½)/M``, in
-    fixed point, by Bluestein's chirp: with ``w = e^{iπ/(2M)}`` and ``2ki = k² + i² − (k − i)²``,
+    """The arc's Chebyshev matrix ``T_{k,i} = cos(k θ_i)``, ``θ_i = π (i + ½)/M`` (a DCT-II; Tᵀ a DCT-III), applied
+    to two real vectors at once in fixed point: Makhoul's reordering makes T x the real part of a length-M DFT,
 
-        (T x)_k = Re(w^{k + k²} Σ_i (x_i w^{i²}) w^{−(k−i)²}),   (Tᵀ x)_i = Re(w^{i²} Σ_k (x_k w^{k + k²}) w^{−(i−k)²}),
+        (T x)_k = Re(e^{−iπk/(2M)} V_k),   V = DFT(v),   v = (x_0, x_2, …, x_{M−2}, x_{M−1}, …, x_3, x_1),
 
-    so each is one complex convolution with the chirp ``w^{−m²}`` — three integer convolutions (Karatsuba), each one
-    GMP product of Kronecker-packed vectors (:func:`~lindstedt.algebra.cosine._pack`).  x is scaled to integers
-    relative to its largest entry and the chirp's values to 2^bits; the rounding adds ~4 M 2^-bits of the largest
-    entry (the guard bits cover M ≤ 1024 four times over).  Only the 4M values of ``w^e`` are computed, not the M²
-    entries of T.  The per-node work is numpy object arrays of gmpy2 integers; in and out go gmpy2 mpfr at the
-    caller's gmpy2 precision.  Measured at 61 digits, M = 1024: 5.5 ms a transform (9.3 ms with mpmath numbers in
-    and out), of which 4 ms are the three GMP products.
+    and Tᵀ its inverse (``v = IDFT(e^{iπk/(2M)} (b_k − i b_{M−k}))/2``, b_M = 0, unshuffled), so two real vectors are the
+    real and imaginary parts of one complex DFT, split by ``V_k = (Z_k + conj Z_{−k})/2``.  The DFT is Bluestein's
+    chirp, ``nk = (n² + k² − (k − n)²)/2``:
+
+        Z_k = W^{k²} Σ_n (u_n W^{n²}) W^{−(k−n)²},   W = e^{−iπ/M},
+
+    one complex convolution with the chirp ``W^{−m²}`` — three integer convolutions (Karatsuba), each one GMP product
+    of Kronecker-packed vectors (:func:`~lindstedt.algebra.cosine._pack`).  Each input vector is scaled to integers
+    relative to its own largest entry (the split is linear) and the roots of unity to 2^bits; the rounding adds
+    ~8 M 2^-bits of that entry (the guard bits cover M ≤ 1024 twice over).  Only the 4M values of ``e^{−iπe/(2M)}``
+    are computed, not the M² entries of T.  The per-node work is numpy object arrays of gmpy2 integers; in and out
+    go gmpy2 mpfr at the caller's gmpy2 precision.  Measured at 61 digits, M = 1024: two transforms 5.7 ms, where
+    one took 9.3 ms as a length-M Bluestein DCT with mpmath numbers in and out; 4 ms are the three GMP products.
     """
 
     def __init__(self, size: int, digits: int):
+        if size % 2:
+            raise ValueError("the fixed-point Chebyshev transform needs an even number of points")
         self.size = size
-        self.bits = int(digits * 3.33) + 28
-        period = 4 * size  # w^e depends on e mod 4M
-        with gmpy2.context(precision=self.bits + 20):
+        bits = self.bits = int(digits * 3.33) + 28
+        period = 4 * size  # e^{−iπe/(2M)} depends on e mod 4M
+        with gmpy2.context(precision=bits + 20):
             angle = gmpy2.const_pi() / (2 * size)
             table = []
             for e in range(period):
                 sine, cosine = gmpy2.sin_cos(angle * e)
-                table.append((gmpy2.mpz(gmpy2.mul_2exp(cosine, self.bits)), gmpy2.mpz(gmpy2.mul_2exp(sine, self.bits))))
-        square = [(k * k) % period for k in range(size)]
-        # w^{k²} and w^{k + k²}, real and imaginary parts
-        self._square = tuple(_array(part) for part in zip(*[table[e] for e in square]))
-        self._square_linear = tuple(_array(part) for part in zip(*[table[(e + k) % period] for k, e in enumerate(square)]))
-        # the chirp w^{−m²}, m = −(M−1) … M−1, as the real, imaginary and summed parts of the Karatsuba products
-        chirp = [table[(-(m * m)) % period] for m in range(-(size - 1), size)]
-        # digits of the packed convolutions: |g| < 2^(bits+1), |chirp| < 2^(bits+1), M terms, a sign
-        self._width = 2 * self.bits + size.bit_length() + 6
+                table.append((gmpy2.mpz(cosine * _TWO**bits), -gmpy2.mpz(sine * _TWO**bits)))
+        self._square = tuple(_array(part) for part in zip(*[table[(2 * k * k) % period] for k in range(size)]))  # W^{k²}
+        self._twist = tuple(_array(part) for part in zip(*table[:size]))  # e^{−iπk/(2M)}
+        # the chirp W^{−m²}, m = −(M−1) … M−1, as the real, imaginary and summed parts of the Karatsuba products
+        chirp = [table[(-2 * m * m) % period] for m in range(-(size - 1), size)]
+        # digits of the packed convolutions: |g| < 2^(bits+2), |chirp| < 2^(bits+1), M terms, a sign
+        self._width = 2 * bits + size.bit_length() + 6
         self._chirp = [_pack(part, self._width) for part in ([c for c, _ in chirp], [c_s for _, c_s in chirp],
                                                               [c + c_s for c, c_s in chirp])]
         half = 1 << (self._width - 1)
         self._half, self._lift = half, gmpy2.pack([half] * (3 * size - 2), self._width)  # signed digits read back
+        self._negated = (-np.arange(size)) % size  # −k mod M
+        self._reversed = np.concatenate([[0], np.arange(size - 1, 0, -1)])  # M − k, with b_M = 0 read at k = 0
 
-    def apply(self, values: np.ndarray, transposed: bool = False) -> np.ndarray:
-        size, bits = self.size, self.bits
+    def _integers(self, values: np.ndarray | None) -> tuple[np.ndarray, int]:
+        """values · 2^shift rounded to integers, the largest near 2^bits."""
+        if values is None:
+            return np.zeros(self.size, dtype=object), 0
         largest = max(abs(v) for v in values)
         if not largest:
-            return np.full(len(values), gmpy2.mpfr(0), dtype=object)
-        shift = bits - gmpy2.get_exp(largest)
+            return np.zeros(self.size, dtype=object), 0
+        shift = self.bits - gmpy2.get_exp(largest)
         scale = _TWO**shift  # a power of two: exact
-        x = _array([gmpy2.mpz(v * scale) for v in values])
-        (c, s_), (c_after, s_after) = (self._square_linear, self._square) if transposed else (self._square, self._square_linear)
-        real = (x * c) >> bits
-        imaginary = (x * s_) >> bits
+        return _array([gmpy2.mpz(v * scale) for v in values]), shift
+
+    def _dft(self, real: np.ndarray, imaginary: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Z = DFT(real + i imaginary) · 2^bits (integers; the input's scale kept)."""
+        size, bits = self.size, self.bits
+        c, s_ = self._square
+        g_real = (real * c - imaginary * s_) >> bits
+        g_imaginary = (real * s_ + imaginary * c) >> bits
         width, half = self._width, self._half
         products = []
-        for g, chirp in zip((real, imaginary, real + imaginary), self._chirp):
+        for g, chirp in zip((g_real, g_imaginary, g_real + g_imaginary), self._chirp):
             digits = gmpy2.unpack(_pack(g, width) * chirp + self._lift, width)
             products.append(_array(digits[size - 1:2 * size - 1]) - half)
         first, second, third = products
         z_real, z_imaginary = first - second, third - first - second
-        return (c_after * z_real - s_after * z_imaginary) * _TWO ** (-2 * bits - shift)
+        return (c * z_real - s_ * z_imaginary) >> bits, (s_ * z_real + c * z_imaginary) >> bits
+
+    def forward(self, a: np.ndarray, b: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+        """(T a, T b)."""
+        (x, shift_a), (y, shift_b) = self._integers(a), self._integers(b)
+        order = lambda z: np.concatenate([z[0::2], z[1::2][::-1]])  # noqa: E731  Makhoul's v
+        z_real, z_imaginary = self._dft(order(x), order(y))
+        mirrored_real, mirrored_imaginary = z_real[self._negated], z_imaginary[self._negated]
+        twist_real, twist_imaginary = self._twist
+        # 2V = Z + conj Z_{−k}, 2Y = (Z − conj Z_{−k})/i; (T a)_k = Re(e^{−iπk/(2M)} V_k)
+        a_out = twist_real * (z_real + mirrored_real) - twist_imaginary * (z_imaginary - mirrored_imaginary)
+        result_a = a_out * _TWO ** (-shift_a - 2 * self.bits - 1)
+        if b is None:
+            return result_a, None
+        b_out = twist_real * (z_imaginary + mirrored_imaginary) + twist_imaginary * (z_real - mirrored_real)
+        return result_a, b_out * _TWO ** (-shift_b - 2 * self.bits - 1)
+
+    def transposed(self, a: np.ndarray, b: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+        """(Tᵀ a, Tᵀ b)."""
+        (x, shift_a), (y, shift_b) = self._integers(a), self._integers(b)
+        twist_real, twist_imaginary = self._twist  # e^{−iπk/(2M)}: the inverse takes its conjugate
+        reversed_ = self._reversed
+
+        def hermitian(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            """2H_k = e^{iπk/(2M)} (b_k − i b_{M−k}) (k ≥ 1), 2H_0 = 2 b_0."""
+            mirror = values[reversed_]
+            real = (twist_real * values - twist_imaginary * mirror) >> self.bits
+            imaginary = (-twist_imaginary * values - twist_real * mirror) >> self.bits
+            real[0], imaginary[0] = 2 * values[0], 0
+            return real, imaginary
+
+        (p, q), (r, s_) = hermitian(x), hermitian(y)
+        # G = H_a + i H_b; IDFT(G) = conj DFT(conj G) = v_a + i v_b (both real): DFT of conj G, imaginary part negated
+        z_real, z_imaginary = self._dft(p - s_, -(q + r))
+        size = self.size
+
+        def unshuffle(v: np.ndarray) -> np.ndarray:
+            out = np.empty(size, dtype=object)
+            out[0::2], out[1::2] = v[:size // 2], v[size // 2:][::-1]
+            return out
+
+        result_a = unshuffle(z_real) * _TWO ** (-shift_a - self.bits - 1)
+        if b is None:
+            return result_a, None
+        return result_a, unshuffle(-z_imaginary) * _TWO ** (-shift_b - self.bits - 1)
 
 
 class FloatArc:
@@ -289,27 +347,35 @@ class VectorArc:
             self._series: list[list[np.ndarray]] = []  # Chebyshev coefficients of Y_{n,k}
             self.tail = gmpy2.mpfr(0)
 
-    def _coefficients(self, values: np.ndarray) -> np.ndarray:
-        """Chebyshev coefficients a_k (a_0 halved) of the interpolant through the node values."""
-        coefficients = self._fast.apply(values) * (gmpy2.mpfr(2) / self.nodes)
-        coefficients[0] /= 2
-        return coefficients
+    def _coefficients(self, values: np.ndarray, other: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+        """Chebyshev coefficients a_k (a_0 halved) of the interpolants through the node values (one or two vectors)."""
+        scale = gmpy2.mpfr(2) / self.nodes
+        result = []
+        for coefficients in self._fast.forward(values, other):
+            if coefficients is not None:
+                coefficients = coefficients * scale
+                coefficients[0] /= 2
+            result.append(coefficients)
+        return result[0], result[1]
 
-    def _integral_to_end(self, integrand: np.ndarray) -> tuple[np.ndarray, Any, np.ndarray]:
-        """∫_v^1 h(ν) dν at every node, ∫_0^1 h, and h's Chebyshev coefficients: cumulative Chebyshev integration in
-        x = 2ν − 1."""
+    def _integrals_to_end(self, first: np.ndarray, second: np.ndarray) -> list[tuple[np.ndarray, Any, np.ndarray]]:
+        """For two integrands h: ∫_v^1 h(ν) dν at every node, ∫_0^1 h, and h's Chebyshev coefficients (cumulative
+        Chebyshev integration in x = 2ν − 1)."""
         M = self.nodes
-        coefficients = self._coefficients(integrand)
-        a = np.concatenate([coefficients, self._zero[:2]])
-        b = np.empty(M + 1, dtype=object)
-        b[0] = gmpy2.mpfr(0)
-        b[1] = a[0] - a[2] / 2
-        b[2:] = (a[1:M] - a[3:M + 2]) / (2 * np.arange(2, M + 1))
-        top = b.sum()
-        bottom = b[0::2].sum() - b[1::2].sum()
+        steps = 2 * np.arange(2, M + 1)
+        integrals, sums = [], []
+        for coefficients in self._coefficients(first, second):
+            a = np.concatenate([coefficients, self._zero[:2]])
+            b = np.empty(M + 1, dtype=object)
+            b[0] = gmpy2.mpfr(0)
+            b[1] = a[0] - a[2] / 2
+            b[2:] = (a[1:M] - a[3:M + 2]) / steps
+            top = b.sum()
+            integrals.append(b[:M])
+            sums.append((top, (top - (b[0::2].sum() - b[1::2].sum())) / 2, coefficients))
         # T_M(x_i) = cos(M θ_i) = 0 at first-kind nodes: Σ_{k<M} b_k T_k(x_i), the transposed transform
-        at_nodes = (top - self._fast.apply(b[:M], transposed=True)) / 2
-        return at_nodes, (top - bottom) / 2, coefficients
+        return [((top - at_nodes) / 2, total, coefficients)
+                for at_nodes, (top, total, coefficients) in zip(self._fast.transposed(*integrals), sums)]
 
     # -- the law on the arc -----------------------------------------------------------------------------
     def _projection(self, vector: np.ndarray, order: int) -> np.ndarray:
@@ -396,8 +462,8 @@ class VectorArc:
                 forcing = forcing - mu * self._second[order - i][k]
             cosine, sine = self._trig[k]
             weighted = forcing if self._jacobian is None else self._jacobian * forcing
-            cos_integral, cos_total, coefficients = self._integral_to_end(cosine * weighted)
-            sin_integral, sin_total, _ = self._integral_to_end(sine * weighted)
+            (cos_integral, cos_total, coefficients), (sin_integral, sin_total, _) = \
+                self._integrals_to_end(cosine * weighted, sine * weighted)
             omega = self._omega[k]
             end_sin, end_cos = gmpy2.sin_cos(omega)
             scale = max(abs(a) for a in coefficients) or gmpy2.mpfr(1)
@@ -430,11 +496,13 @@ class VectorArc:
             values_all.append(values)
             second_all.append(force - (omega * omega) * values)
             slopes_all.append(slopes)
-            value_series = self._coefficients(values)
-            series.append(value_series)
-            size = max(abs(a) for a in value_series)
-            if size:
-                self.tail = max(self.tail, max(abs(a) for a in value_series[-4:]) / size)
+        for k in range(0, self.size, 2):  # two components a transform
+            pair = self._coefficients(*values_all[k:k + 2])
+            for value_series in pair[:len(values_all[k:k + 2])]:
+                series.append(value_series)
+                size = max(abs(a) for a in value_series)
+                if size:
+                    self.tail = max(self.tail, max(abs(a) for a in value_series[-4:]) / size)
         stacked = np.vstack(values_all)
         for vector in self._vectors:
             key = (id(vector), order)
@@ -533,13 +601,13 @@ class VectorArc:
             if order:
                 key = (order, component)
                 if key not in self._slope_series:
-                    self._slope_series[key] = self._coefficients(self._slopes[order - 1][component])
+                    self._slope_series[key] = self._coefficients(self._slopes[order - 1][component])[0]
                 values, slopes = self._series[order - 1][component], self._slope_series[key]
             else:  # Y_0 = e_j cos βτ and its τ-slope, interpolated on the same grid
                 cosine, sine = self._trig[component]
                 on = component == self.mode
-                values = self._coefficients(cosine if on else self._zero)
-                slopes = self._coefficients(-self._omega[component] * sine if on else self._zero)
+                values, slopes = self._coefficients(cosine if on else self._zero,
+                                                    -self._omega[component] * sine if on else self._zero)
             return [_mpf(a) for a in values], [_mpf(a) for a in slopes]
 
     @locked
