@@ -8,9 +8,10 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
-from sympy import Rational
+from sympy import QQ
 
 from .._precision import locked
+from ..algebra.branch import domain_constant
 from ..algebra.contact_field import sum_of_products
 from ..limits import checkpoint
 
@@ -27,7 +28,7 @@ def extend_square_root(roots: list[Any], squared: Callable[[int], Any], order: i
     >>> print(extend_square_root(roots, lambda k: [QQ(1), QQ(1, 2), QQ(-3, 16)][k], 2, QQ))   # Ω² = 1 + ε/2 − 3ε²/16
     -1/8
     """
-    half = domain.convert(Rational(1, 2))
+    half = domain_constant(domain, QQ(1, 2))
     while len(roots) <= order:
         k = len(roots)
         value = squared(k)

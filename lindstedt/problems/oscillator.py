@@ -464,8 +464,12 @@ class Oscillator:
 
         known = {"u": DISPLACEMENT, **parameter_symbols}
         expression = parse_expression(self.f, symbols=known, what="f")
-        expression = expression.subs({sympy.Symbol("u"): DISPLACEMENT})
-        expression = expression.subs({sympy.Symbol(n): s for n, s in parameter_symbols.items()})
+        present = expression.free_symbols  # only the plain symbols that occur are replaced (subs of the rest is a no-op)
+        if sympy.Symbol("u") in present:
+            expression = expression.subs({sympy.Symbol("u"): DISPLACEMENT})
+        plain = {sympy.Symbol(n): s for n, s in parameter_symbols.items() if sympy.Symbol(n) in present}
+        if plain:
+            expression = expression.subs(plain)
         foreign = expression.free_symbols - {DISPLACEMENT} - set(parameter_symbols.values())
         if foreign:
             names = ", ".join(sorted(str(s) for s in foreign))
