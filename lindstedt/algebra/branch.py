@@ -318,10 +318,12 @@ class Branch:
         """True when there are no terms."""
         return not self.terms
 
+    # A branch's terms never hold sin(0 s) (the constructor drops it), and sums, differences and derivatives of such
+    # terms make none: the loops below add into their dictionaries directly (cancelled terms dropped by Branch()).
     def __add__(self, other: "Branch") -> "Branch":
         result = dict(self.terms)
         for key, value in other.terms.items():
-            _add_into(result, key, value)
+            result[key] = result[key] + value if key in result else value
         return Branch(self.domain, result)
 
     def __neg__(self) -> "Branch":
@@ -330,7 +332,7 @@ class Branch:
     def __sub__(self, other: "Branch") -> "Branch":
         result = dict(self.terms)
         for key, value in other.terms.items():
-            _add_into(result, key, -value)
+            result[key] = result[key] + -value if key in result else -value
         return Branch(self.domain, result)
 
     def scale(self, factor: Any) -> "Branch":
@@ -341,26 +343,28 @@ class Branch:
 
     def _from_rational(self, rational_terms: Iterable[tuple[TermKey, Any]], factor: Any, into: dict) -> None:
         domain = self.domain
-        for key, value in rational_terms:
-            _add_into(into, key, factor * domain_constant(domain, value))
+        for key, value in rational_terms:  # keys of _oscillator_inverse / _antiderivative: no sin(0 s)
+            term = factor * domain_constant(domain, value)
+            into[key] = into[key] + term if key in into else term
 
     def derivative(self) -> "Branch":
         """d/ds, exactly."""
         result: dict[TermKey, Any] = {}
         domain = self.domain
-
-        def convert(value: int) -> Any:
-            return domain_constant(domain, value)
-
         for (harmonic, parity, power), value in self.terms.items():
-            if power:
-                _add_into(result, (harmonic, parity, power - 1), value * convert(power))
-            if harmonic.__class__ is int and harmonic == 1:  # multiplying by 1 changes nothing (not even a rounding)
-                _add_into(result, (1, 1 - parity, power), value if parity else -value)
-            elif harmonic:
-                factor = convert(harmonic) if isinstance(harmonic, int) else harmonic
-                _add_into(result, (harmonic, 1 - parity, power), value * factor if parity else -(value * factor))
-        return Branch(self.domain, result)
+            if power:  # a factor 1 changes nothing (not even a float's rounding): not multiplied
+                term = value if power == 1 else value * domain_constant(domain, power)
+                key = (harmonic, parity, power - 1)
+                result[key] = result[key] + term if key in result else term
+            if harmonic:
+                if harmonic.__class__ is int and harmonic == 1:
+                    term = value if parity else -value
+                else:
+                    factor = domain_constant(domain, harmonic) if isinstance(harmonic, int) else harmonic
+                    term = value * factor if parity else -(value * factor)
+                key = (harmonic, 1 - parity, power)
+                result[key] = result[key] + term if key in result else term
+        return Branch(domain, result)
 
     def __mul__(self, other: "Branch") -> "Branch":
         """Product of two branches (product-to-sum; powers of s add; RealField harmonics snapped, :func:`_snapped`).

@@ -100,7 +100,10 @@ class PiecewiseNormalForm:
 
     def scaled_expr(self, element: Any, power: int, prefactor: sympy.Expr) -> sympy.Expr:
         """``prefactor · (1/ω0²)^(power/gauge) · element`` in the problem's symbols (η^power = (ε/ω0²)^(power/gauge))."""
-        return prefactor * self.epsilon_scale ** sympy.Rational(power, self.gauge) * self.to_expr(element)
+        scale = self.epsilon_scale ** sympy.Rational(power, self.gauge)
+        if prefactor is sympy.S.One and scale is sympy.S.One and element:  # ω0 = 1: 1 · 1 · x is x (a zero
+            return self.to_expr(element)                                   # Float becomes sympy's 0 in the product)
+        return prefactor * scale * self.to_expr(element)
 
 
 class _ConstantField:
