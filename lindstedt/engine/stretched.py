@@ -124,6 +124,9 @@ class _FixedPointTransform:
                 table.append((gmpy2.mpz(cosine * _TWO**bits), -gmpy2.mpz(sine * _TWO**bits)))
         self._square = tuple(_array(part) for part in zip(*[table[(2 * k * k) % period] for k in range(size)]))  # W^{k²}
         self._twist = tuple(_array(part) for part in zip(*table[:size]))  # e^{−iπk/(2M)}
+        # P_k = e^{−iπk/(2M)} W^{k²} and Q_k = e^{−iπk/(2M)} conj W^{k²}
+        self._post = tuple(tuple(_array(part) for part in zip(*[table[(k + sign * 2 * k * k) % period] for k in range(size)]))
+                           for sign in (1, -1))
         # the chirp W^{−m²}, m = −(M−1) … M−1, as the real, imaginary and summed parts of the Karatsuba products
         chirp = [table[(-2 * m * m) % period] for m in range(-(size - 1), size)]
         # digits of the packed convolutions: |g| < 2^(bits+2), |chirp| < 2^(bits+1), M terms, a sign
@@ -146,35 +149,40 @@ class _FixedPointTransform:
         scale = _TWO**shift  # a power of two: exact
         return _array([gmpy2.mpz(v * scale) for v in values]), shift
 
-    def _dft(self, real: np.ndarray, imaginary: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Z = DFT(real + i imaginary) · 2^bits (integers; the input's scale kept)."""
+    def _convolution(self, real: np.ndarray, imaginary: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        """z_k = Σ_n (u_n W^{n²}) W^{−(k−n)²} · 2^bits for u = real + i imaginary (integers; Z_k = W^{k²} z_k)."""
         size, bits = self.size, self.bits
         c, s_ = self._square
-        g_real = (real * c - imaginary * s_) >> bits
-        g_imaginary = (real * s_ + imaginary * c) >> bits
+        if imaginary is None:
+            g_real, g_imaginary = (real * c) >> bits, (real * s_) >> bits
+        else:
+            g_real = (real * c - imaginary * s_) >> bits
+            g_imaginary = (real * s_ + imaginary * c) >> bits
         width, half = self._width, self._half
         products = []
         for g, chirp in zip((g_real, g_imaginary, g_real + g_imaginary), self._chirp):
             digits = gmpy2.unpack(_pack(g, width) * chirp + self._lift, width)
             products.append(_array(digits[size - 1:2 * size - 1]) - half)
         first, second, third = products
-        z_real, z_imaginary = first - second, third - first - second
-        return (c * z_real - s_ * z_imaginary) >> bits, (s_ * z_real + c * z_imaginary) >> bits
+        return first - second, third - first - second
 
     def forward(self, a: np.ndarray, b: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None]:
         """(T a, T b)."""
         (x, shift_a), (y, shift_b) = self._integers(a), self._integers(b)
         order = lambda z: np.concatenate([z[0::2], z[1::2][::-1]])  # noqa: E731  Makhoul's v
-        z_real, z_imaginary = self._dft(order(x), order(y))
+        z_real, z_imaginary = self._convolution(order(x), None if b is None else order(y))
         mirrored_real, mirrored_imaginary = z_real[self._negated], z_imaginary[self._negated]
-        twist_real, twist_imaginary = self._twist
-        # 2V = Z + conj Z_{−k}, 2Y = (Z − conj Z_{−k})/i; (T a)_k = Re(e^{−iπk/(2M)} V_k)
-        a_out = twist_real * (z_real + mirrored_real) - twist_imaginary * (z_imaginary - mirrored_imaginary)
-        result_a = a_out * _TWO ** (-shift_a - 2 * self.bits - 1)
+        (p_real, p_imaginary), (q_real, q_imaginary) = self._post
+        # 2V_k = Z_k + conj Z_{−k}, 2Y_k = (Z_k − conj Z_{−k})/i with Z_k = W^{k²} z_k, and (T a)_k = Re(e^{−iπk/(2M)} V_k):
+        # with P_k = e^{−iπk/(2M)} W^{k²}, Q_k = e^{−iπk/(2M)} conj W^{k²},
+        # 2(T a)_k = Re(P_k z_k + Q_k conj z_{−k}),   2(T b)_k = Im(P_k z_k − Q_k conj z_{−k})
+        scale = -2 * self.bits - 1
+        a_out = p_real * z_real - p_imaginary * z_imaginary + q_real * mirrored_real + q_imaginary * mirrored_imaginary
+        result_a = a_out * _TWO ** (scale - shift_a)
         if b is None:
             return result_a, None
-        b_out = twist_real * (z_imaginary + mirrored_imaginary) + twist_imaginary * (z_real - mirrored_real)
-        return result_a, b_out * _TWO ** (-shift_b - 2 * self.bits - 1)
+        b_out = p_real * z_imaginary + p_imaginary * z_real - q_imaginary * mirrored_real + q_real * mirrored_imaginary
+        return result_a, b_out * _TWO ** (scale - shift_b)
 
     def transposed(self, a: np.ndarray, b: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None]:
         """(Tᵀ a, Tᵀ b)."""
@@ -190,20 +198,25 @@ class _FixedPointTransform:
             real[0], imaginary[0] = 2 * values[0], 0
             return real, imaginary
 
-        (p, q), (r, s_) = hermitian(x), hermitian(y)
-        # G = H_a + i H_b; IDFT(G) = conj DFT(conj G) = v_a + i v_b (both real): DFT of conj G, imaginary part negated
-        z_real, z_imaginary = self._dft(p - s_, -(q + r))
-        size = self.size
+        (p, q) = hermitian(x)
+        if b is None:
+            z_real, z_imaginary = self._convolution(p, -q)
+        else:
+            r, s_ = hermitian(y)
+            z_real, z_imaginary = self._convolution(p - s_, -(q + r))
+        # G = H_a + i H_b; IDFT(G) = conj DFT(conj G) = v_a + i v_b (both real), DFT(conj G)_k = W^{k²} z_k
+        c, s_ = self._square
+        size, scale = self.size, -2 * self.bits - 1
 
         def unshuffle(v: np.ndarray) -> np.ndarray:
             out = np.empty(size, dtype=object)
             out[0::2], out[1::2] = v[:size // 2], v[size // 2:][::-1]
             return out
 
-        result_a = unshuffle(z_real) * _TWO ** (-shift_a - self.bits - 1)
+        result_a = unshuffle(c * z_real - s_ * z_imaginary) * _TWO ** (scale - shift_a)
         if b is None:
             return result_a, None
-        return result_a, unshuffle(-z_imaginary) * _TWO ** (-shift_b - self.bits - 1)
+        return result_a, unshuffle(-(s_ * z_real + c * z_imaginary)) * _TWO ** (scale - shift_b)
 
 
 class FloatArc:
