@@ -128,7 +128,14 @@ class ExpansionFeatures:
 
 def _degree(f: sympy.Expr, variable: sympy.Symbol) -> int:
     """The polynomial degree of f in u, reading every switch as linear (``Max(0, u)**2`` has degree 2)."""
-    linear = f.replace(lambda e: isinstance(e, _SWITCHES + (sympy.Piecewise,)), lambda e: variable)
+    kinds = _SWITCHES + (sympy.Piecewise,)
+    switches = f.atoms(*kinds)
+    if any(argument.has(*kinds) for switch in switches for argument in switch.args):  # nested: bottom-up
+        linear = f.replace(lambda e: isinstance(e, kinds), lambda e: variable)
+    else:  # every switch is outermost: the same replacement as one substitution
+        linear = f.xreplace({switch: variable for switch in switches})
+    if linear == variable:
+        return 1
     try:
         degree = sympy.Poly(linear, variable).degree()
         if degree.is_infinite if isinstance(degree, sympy.Basic) else False:  # the switches cancel: Max(0, u) - Max(0, -u)
