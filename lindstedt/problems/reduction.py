@@ -33,8 +33,14 @@ gives the K'-reduction of the full model exactly (its basis spans K⁻¹W), so t
 modes is 1e-3 off at 10⁴ dof), so the basis is computed in multiprecision (gmpy2 ``mpfr`` at the working digits
 plus ``log10 cond(K)`` and guard digits): ``K = L D Lᵀ`` in its band after a reverse Cuthill–McKee ordering —
 O(N b²) for the factorisation, O(N b) per right-hand side, O(N · (K + m)) numbers kept — and subspace
-iteration ``Y ← K⁻¹ M X`` with a Rayleigh–Ritz step (Bathe & Wilson 1972) from the float Lanczos modes until
-the K Ritz values are stationary to twice the working precision (the vectors then to the working precision).
+iteration with a Rayleigh–Ritz step (Bathe & Wilson 1972) from the float Lanczos modes, accelerated by Chebyshev
+polynomials (Rutishauser 1970): between two Ritz steps the q columns X advance by ``T_s(2θ_q K⁻¹M − I) X``, which
+damps the modes above the last Ritz value θ_q and lifts mode K by ``T_s(x)``, ``x = 2θ_q/θ_K − 1`` — a Ritz
+value's error falls by ``(x + √(x² − 1))²`` a step, against ``(θ_q/θ_K)²`` for plain inverse iteration (5.5 against
+2.3 bits a step on a string-like chain with K = 8, q = 12).  The iteration stops when the K Ritz values are
+stationary to twice the working precision (the vectors then to the working precision): when their last change
+times the slower of the observed and the predicted rate is below 2^-2t.  The small Ritz eigenproblems are solved
+in mpfr by Jacobi sweeps from float64 eigenvectors.
 Products with K cancel up to log2 cond(K) bits, which the working precision holds in reserve.
 """
 
@@ -52,15 +58,22 @@ import sympy
 from .._budget import Estimate, checkpoint
 from .._errors import ProblemError
 from .._precision import warn_caller
-from .modes import _leading_sign
+from .modes import _leading_sign, _leading_signs
 from .system import UnilateralSystem
 
 __all__ = ["ResidualFlexibility", "ReducedStructure"]
 
-#: CPU seconds of one multiprecision multiply-add on a row of the band (gmpy2 mpfr in numpy object arrays,
-#: ~200 bits; measured: 3.7 µs for a row operation on 20 columns)
-_SECONDS_PER_OPERATION = 2.0e-7
+#: CPU seconds of one multiprecision operation of the reduction (gmpy2 mpfr in numpy object arrays, ~360 bits),
+#: fitted to the measured CPU time of the operation count of :meth:`ResidualFlexibility.estimate` (at the
+#: iterations done): 1.4e-7 on a chain of 1000 and 2000 dof (b = 1), 1.4e-7 to 1.6e-7 on beams of 400 and 1000
+#: dof (b = 4), the fixed costs (float modes, imports) making small models dearer per operation
+_SECONDS_PER_OPERATION = 1.5e-7
 _MAX_ITERATIONS = 60
+#: Chebyshev steps between two Ritz steps at most, and the bits held in reserve for the columns' drift between them
+_MAX_STEPS = 8
+_GUARD_BITS = 96
+#: cyclic Jacobi sweeps allowed on a small symmetric matrix (from float64 eigenvectors: 3–4 reach 400 bits)
+_MAX_SWEEPS = 12
 
 
 def _gmpy2() -> Any:
@@ -199,14 +212,15 @@ class _BandedLDL:
             self._columns.append((stop, np.array(coefficients, dtype=object)))
         self._diagonal = np.array(diagonal, dtype=object)[:, None]
 
-    def solve(self, columns: np.ndarray) -> np.ndarray:
-        """``S⁻¹ columns`` for an (n, c) object array of mpfr (one small dot per row and sweep: the band's entries
-        of a row, or of a column of L, against the rows of the right-hand side they meet)."""
+    def solve(self, columns: np.ndarray, scale: Any = 1) -> np.ndarray:
+        """``scale · S⁻¹ columns`` for an (n, c) object array of mpfr (one small dot per row and sweep: the band's
+        entries of a row, or of a column of L, against the rows of the right-hand side they meet; ``scale`` joins
+        the division by D)."""
         y = columns[self.order].copy()
         for i, (start, coefficients) in enumerate(self._rows):
             if start < i:
                 y[i] = y[i] - coefficients.dot(y[start:i])
-        y = y / self._diagonal
+        y = y / self._diagonal if scale == 1 else y * (scale / self._diagonal)
         for j in range(self.n - 1, -1, -1):  # Lᵀ: x_j = y_j − Σ_{i > j} L[i, j] x_i
             stop, coefficients = self._columns[j]
             if stop > j + 1:
@@ -251,6 +265,14 @@ def _dense(entries: dict[tuple[int, int], Any], shape: tuple[int, int], transpos
     for (i, j), value in entries.items():
         array[(j, i) if transposed else (i, j)] = _mpfr(value)
     return array
+
+
+def _rows_times(entries: dict[tuple[int, int], Any], rows: int, columns: np.ndarray) -> np.ndarray:
+    """``S @ columns`` for a sparse exact (rows × N) matrix S given by its entries ``(r, i) -> value``."""
+    result = np.full((rows, columns.shape[1]), _gmpy2().mpfr(0), dtype=object)
+    for (r, i), value in entries.items():
+        result[r] += _mpfr(value) * columns[i]
+    return result
 
 
 def _to_mpmath(value: Any) -> Any:
@@ -428,10 +450,11 @@ class ResidualFlexibility:
     def estimate(self, n: int, bandwidth: int, elements: int, iterations: int, steps: int = 1) -> Estimate:
         """The cost of a reduction of an N-dof model whose K has half-bandwidth ``bandwidth``."""
         columns = self.modes + max(4, self.modes // 2)
-        # the factorisation, then per iteration the band solves and products (N (4b + 5) q), every ``steps``
-        # iterations the Gram matrices and the Ritz transforms (4 N q²), then the residual vectors
-        operations = (n * bandwidth**2 + iterations * n * ((4 * bandwidth + 5) * columns + 4 * columns**2 / steps)
-                      + n * (2 * bandwidth + 1) * elements)
+        # the factorisation, then per Chebyshev step the band solve, the product with M and the recurrence
+        # (N (8b + 6) q), every ``steps`` steps the Gram matrices and the Ritz transform (3 N q²), then the residual
+        # vectors and the projections (N ((2b + 1) m + 2 (K + m)²))
+        operations = (n * bandwidth**2 + iterations * n * ((8 * bandwidth + 6) * columns + 3 * columns**2 / steps)
+                      + n * ((2 * bandwidth + 1) * elements + 2 * (self.modes + elements) ** 2))
         return Estimate(task=f"residual-flexibility reduction of a {n}-dof model to {self.modes} modes",
                         seconds=_SECONDS_PER_OPERATION * operations,
                         memory_mb=3e-4 * n * (bandwidth + 6 * columns + elements),  # ~150 bytes per mpfr kept
@@ -463,48 +486,55 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
     conditioning = max(1.0, stiffest / lightest / float(theta[0]))
     # the Ritz values are stationary to 2^-2t when the vectors are to 2^-t (t the target bits): room for both
     target = int(math.ceil(method.digits * math.log2(10))) + 8
-    # between two Ritz steps ``steps`` inverse iterations run on the columns alone (the Ritz step's products are
-    # O(N q²), an iteration's O(N b q)): the columns drift towards the lowest mode by log2(θ_q/θ_1) bits a step,
-    # which 64 guard bits absorb (measured: 3x fewer CPU seconds at 2001 dof than a Ritz step per iteration)
-    drift = max(1, int(math.ceil(math.log2(float(theta[-1] / theta[0])))))
-    steps = max(1, min(8, 64 // drift))
-    bits = 2 * target + int(math.ceil(math.log2(conditioning))) + 32 + 64
-    rate = float(theta[K - 1] / theta[-1]) if columns > K else 0.5
-    # a Ritz value's error falls by rate² = (θ_K/θ_q)² per iteration, from the float modes' (~2^-20 at worst)
-    iterations = min(_MAX_ITERATIONS, int(math.ceil(2 * target / max(1.0, -2 * math.log2(max(rate, 1e-300))))) + steps)
+    # between two Ritz steps ``steps`` Chebyshev steps run on the columns alone (the Ritz step's products are
+    # O(N q²), a step's O(N b q)): the columns drift towards the lowest mode by log2 T_1(x_1) ≈ log2(4θ_q/θ_1) bits
+    # a step, which the guard bits absorb
+    drift = max(1, int(math.ceil(math.log2(4 * float(theta[-1] / theta[0])))))
+    steps = max(1, min(_MAX_STEPS, _GUARD_BITS // drift))
+    bits = 2 * target + int(math.ceil(math.log2(conditioning))) + 32 + _GUARD_BITS
+    # a Ritz value's error falls by ρ² a step, ρ = 1/(x + √(x² − 1)), x = 2θ_q/θ_K − 1 (Chebyshev on [0, 1/θ_q]
+    # against the kept mode K; a Krylov-free ρ would be θ_K/θ_q), from the float modes' (~2^-20 at worst)
+    x = 2 * float(theta[-1] / theta[K - 1]) - 1
+    gain = 2 * math.log2(x + math.sqrt(x * x - 1)) if x > 1 else 1.0
+    iterations = min(_MAX_ITERATIONS, int(math.ceil((2 * target - 20) / max(1.0, gain))) + steps)
     with gmpy2.context(gmpy2.get_context(), precision=bits):
         factor = _BandedLDL(stiffness, n)
         method.estimate(n, factor.width, m, iterations, steps).check()
         product = _SparseProduct(mass, n)
-        to_mpfr = np.vectorize(lambda v: gmpy2.mpfr(float(v)), otypes=[object])
-        X = to_mpfr(float_modes.shapes)
+        X = np.frompyfunc(gmpy2.mpfr, 1, 1)(np.asarray(float_modes.shapes, dtype=float))
         MX = product.times(X)
         previous: list[Any] | None = None
-        success, done, solves, change = False, 0, 0, math.inf
-        tolerance = mpmath.mpf(2) ** (-2 * target)
+        success, done, solves, change, last = False, 0, 0, math.inf, None
+        tolerance = gmpy2.mpfr(2) ** (-2 * target)
         with mpmath.workprec(bits):
+            upper = gmpy2.mpfr(float(theta[-1]))  # the damped interval of K⁻¹M: [0, 1/θ_q]
+            stiffness_product = _SparseProduct(stiffness, n)
             while done < _MAX_ITERATIONS:
+                # Y_j = T_j(2 θ_q K⁻¹M − I) X (Chebyshev: Y_{j+1} = 4 θ_q K⁻¹M Y_j − 2 Y_j − Y_{j−1})
+                before, Y = X, factor.solve(MX, 2 * upper) - X
                 for _ in range(steps - 1):
-                    Y = factor.solve(MX)  # K Y = M X, then each column scaled to a largest entry of about 1
-                    Y = Y / np.max(np.abs(Y), axis=0)
-                    MX = product.times(Y)
-                Y = factor.solve(MX)
+                    before, Y = Y, factor.solve(product.times(Y), 4 * upper) - 2 * Y - before
                 done += steps
                 solves += steps * columns
                 MY = product.times(Y)
-                values, Q = _ritz(_small(Y.T.dot(MX)), _small(Y.T.dot(MY)))
-                transform = np.array([[_to_mpfr(Q[i, j]) for j in range(columns)] for i in range(columns)], dtype=object)
+                values, transform = _ritz(Y.T.dot(stiffness_product.times(Y)), Y.T.dot(MY))
+                upper = values[-1]
                 kept = values[:K]
-                X, MX = Y.dot(transform), MY.dot(transform)
+                X = Y.dot(transform)
+                MX = product.times(X)  # O(N b q) against O(N q²) for MY·transform
                 if previous is not None:
-                    change = float(max(abs(a - b) / abs(a) for a, b in zip(kept, previous)))
-                    if change <= tolerance:
+                    change = max(abs(a - b) / abs(a) for a, b in zip(kept, previous))
+                    # the next change, at the slower of the observed rate and the one T_s(x_K)⁻² implies
+                    x = 2 * values[-1] / values[K - 1] - 1
+                    ratio = max(1 / gmpy2.cosh(steps * gmpy2.acosh(x)) ** 2 if x > 1 else 1, change / last) if last else 1
+                    if change * ratio <= tolerance:
                         success = True
                         break
+                    last = change
                 previous = kept
                 checkpoint("subspace iteration", done, _MAX_ITERATIONS)
             # K X by the sparse product: it cancels log2 cond(K) bits, which the working precision holds in reserve
-            KX = _SparseProduct(stiffness, n).times(X[:, :K])
+            KX = stiffness_product.times(X[:, :K])
             X, MX = X[:, :K], MX[:, :K]
             # each mode signed as the full model's modes are (its first entry of largest magnitude positive)
             signs = np.array([_leading_sign([float(v) for v in X[:, k]]) for k in range(K)], dtype=object)
@@ -524,15 +554,19 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
             keep = [i for i in range(gram.rows) if gram[i] > largest * mpmath.mpf(2) ** (-target)]
             scale = np.array([[_to_mpfr(U[r, i] / mpmath.sqrt(gram[i])) for i in keep] for r in range(gram.rows)], dtype=object)
             Z, KZ = Z.dot(scale), KZ.dot(scale)
+            signs = _leading_signs(Z.astype(float)).astype(object)  # signed as the modes (eigsy's signs are arbitrary)
+            Z, KZ = Z * signs, KZ * signs
             MZ = product.times(Z)
             V, KV, MV = (np.hstack(pair) for pair in ((X, Z), (KX, KZ), (MX, MZ)))
             reduced_mass = V.T.dot(MV)
             reduced_stiffness = V.T.dot(KV)
-            reduced_A = _dense(elements, (m, n)).dot(V)
-            reduced_W = V.T.dot(W)
-            reduced_loads = V.T.dot(P)
+            reduced_A = _rows_times(elements, m, V)  # A V, Wᵀ V and Pᵀ V from the few nonzero entries
+            reduced_W = (reduced_A if forces is None else
+                         _rows_times({(j, i): value for (i, j), value in forces.items()}, m, V)).T
+            reduced_loads = _rows_times({(c, i): value for c, load in enumerate(loads) for i, value in load.items()},
+                                        len(loads), V).T
             basis = V.astype(float)
-            frequencies = tuple(+mpmath.sqrt(value) for value in values[:K])
+            frequencies = tuple(_to_mpmath(gmpy2.sqrt(value)) for value in values[:K])
 
         def exact(matrix: np.ndarray, symmetric: bool) -> sympy.Matrix:
             if symmetric:
@@ -545,9 +579,10 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
     with mpmath.workdps(method.digits):
         frequencies = tuple(+value for value in frequencies)
     message = (f"{K} modes converged to {method.digits} digits in {done} subspace iterations" if success else
-               f"the Ritz values were still moving after {done} subspace iterations (by {change:.1e} relative in the last "
+               f"the Ritz values were still moving after {done} subspace iterations (by {float(change):.1e} relative in the last "
                f"{steps}): the kept modes are not converged to {method.digits} digits, so a kept mode's ω₀, ω₁ are not the "
-               "full model's to that precision (keep fewer modes, or more: the convergence rate is (λ_K/λ_q)²)")
+               "full model's to that precision (keep fewer modes, or more: a step gains a factor (x + √(x² − 1))² with "
+               "x = 2λ_q/λ_K − 1)")
     if not success:
         warn_caller(UserWarning(message))
     return ReducedStructure(system, n, K, frequencies, method.digits, success, message, done, solves, factor.width,
@@ -560,17 +595,70 @@ def _small(matrix: np.ndarray) -> Any:
     return mpmath.matrix([[(_to_mpmath(matrix[i, j]) + _to_mpmath(matrix[j, i])) / 2 for j in range(size)] for i in range(size)])
 
 
-def _ritz(stiffness: Any, mass: Any) -> tuple[list[Any], Any]:
-    """The generalized eigenpairs of the small pencil (stiffness, mass): values increasing, vectors mass-orthonormal."""
-    lower = mpmath.cholesky(mass)
-    inverse = mpmath.inverse(lower)
-    symmetric = inverse * stiffness * inverse.T
-    values, vectors = mpmath.eigsy((symmetric + symmetric.T) / 2)
-    order = sorted(range(len(values)), key=lambda i: values[i])
-    vectors = inverse.T * vectors
-    size = len(values)
-    ordered = mpmath.matrix(size, size)
-    for new, old in enumerate(order):
-        for row in range(size):
-            ordered[row, new] = vectors[row, old]
-    return [values[i] for i in order], ordered
+def _cholesky(matrix: np.ndarray) -> np.ndarray:
+    """The lower Cholesky factor of a small symmetric positive definite object matrix of mpfr."""
+    gmpy2 = _gmpy2()
+    size = matrix.shape[0]
+    lower = np.full((size, size), gmpy2.mpfr(0), dtype=object)
+    for j in range(size):
+        pivot = matrix[j, j] - lower[j, :j].dot(lower[j, :j])
+        if not pivot > 0:
+            raise ProblemError("the subspace basis lost its rank (a Gram matrix is not positive definite): the "
+                               "structure has fewer independent modes than asked for; keep fewer modes")
+        lower[j, j] = gmpy2.sqrt(pivot)
+        for i in range(j + 1, size):
+            lower[i, j] = (matrix[i, j] - lower[i, :j].dot(lower[j, :j])) / lower[j, j]
+    return lower
+
+
+def _forward(lower: np.ndarray, right: np.ndarray) -> np.ndarray:
+    """``L⁻¹ right`` for a lower triangular object matrix L (forward substitution, row by row)."""
+    result = right.copy()
+    for i in range(lower.shape[0]):
+        result[i] = (right[i] - lower[i, :i].dot(result[:i])) / lower[i, i]
+    return result
+
+
+def _eigen(matrix: np.ndarray) -> tuple[list[Any], np.ndarray]:
+    """The eigenpairs of a small symmetric object matrix of mpfr at the context's precision: values increasing,
+    vectors orthonormal.  The float64 eigenvectors, orthonormalised (Cholesky QR), leave off-diagonal entries of
+    ~1e-16 ‖C‖ that cyclic Jacobi sweeps square away (quadratic convergence, clusters included)."""
+    gmpy2 = _gmpy2()
+    size = matrix.shape[0]
+    to_mpfr = np.vectorize(gmpy2.mpfr, otypes=[object])
+    Q = to_mpfr(np.linalg.eigh(matrix.astype(float))[1])
+    Q = _forward(_cholesky(Q.T.dot(Q)), Q.T).T  # Q R⁻¹, R = chol(QᵀQ)ᵀ: orthonormal to the working precision
+    D = Q.T.dot(matrix).dot(Q)
+    D = (D + D.T) / 2
+    floor = gmpy2.mpfr(2) ** (-gmpy2.get_context().precision)
+    for _ in range(_MAX_SWEEPS):
+        rotated = False
+        for p in range(size - 1):
+            for q in range(p + 1, size):
+                off = D[p, q]
+                if abs(off) <= floor * (abs(D[p, p]) + abs(D[q, q])):
+                    continue
+                rotated = True
+                tau = (D[q, q] - D[p, p]) / (2 * off)
+                t = (1 if tau >= 0 else -1) / (abs(tau) + gmpy2.sqrt(1 + tau * tau))
+                c = 1 / gmpy2.sqrt(1 + t * t)
+                s = t * c
+                for array in (D, Q):  # columns p, q of D and Q, then rows p, q of D
+                    first, second = array[:, p].copy(), array[:, q].copy()
+                    array[:, p], array[:, q] = c * first - s * second, s * first + c * second
+                first, second = D[p].copy(), D[q].copy()
+                D[p], D[q] = c * first - s * second, s * first + c * second
+        if not rotated:
+            break
+    order = sorted(range(size), key=lambda i: D[i, i])
+    return [D[i, i] for i in order], Q[:, order]
+
+
+def _ritz(stiffness: np.ndarray, mass: np.ndarray) -> tuple[list[Any], np.ndarray]:
+    """The generalized eigenpairs of the small pencil (stiffness, mass) of object mpfr matrices (symmetrised):
+    values increasing, vectors mass-orthonormal (``L⁻ᵀ`` times the eigenvectors of ``L⁻¹ S L⁻ᵀ``, M = L Lᵀ)."""
+    lower = _cholesky((mass + mass.T) / 2)
+    half = _forward(lower, (stiffness + stiffness.T) / 2)  # L⁻¹ S
+    symmetric = _forward(lower, half.T)  # L⁻¹ (L⁻¹ S)ᵀ = L⁻¹ S L⁻ᵀ
+    values, vectors = _eigen((symmetric + symmetric.T) / 2)
+    return values, _forward(lower.T[::-1, ::-1], vectors[::-1])[::-1]  # L⁻ᵀ: the reversed upper triangle
