@@ -457,13 +457,14 @@ class VectorArc:
         return terms
 
     # -- the hierarchy ----------------------------------------------------------------------------------
-    def _particular(self, order: int) -> list[dict]:
-        """Per component: the forcing without μ_order, P_k at the nodes and P_k(1), P_k'(1)."""
+    def _particular(self, order: int, tolerance: Any = None) -> list[dict] | None:
+        """Per component: the forcing without μ_order, P_k at the nodes and P_k(1), P_k'(1).  With a tolerance, None
+        as soon as one component's forcing is not resolved (the stiffest first: they decide a refinement)."""
         beta2 = self._beta * self._beta
         terms = self._law_terms(order - 1)
         mus = [beta2 * self._mu[i] for i in range(1, order)]
-        out = []
-        for k in range(self.size):
+        out: list[dict] = [{}] * self.size
+        for k in sorted(range(self.size), key=lambda k: -abs(self._omega[k])):
             law = self._zero
             for g, values in terms:
                 if g[k]:
@@ -480,12 +481,14 @@ class VectorArc:
             omega = self._omega[k]
             end_sin, end_cos = gmpy2.sin_cos(omega)
             scale = max(abs(a) for a in coefficients) or gmpy2.mpfr(1)
-            out.append({
+            tail = max(abs(a) for a in coefficients[-4:]) / scale
+            if tolerance is not None and tail > tolerance:
+                return None
+            out[k] = {
                 "forcing": forcing, "cos": cos_integral, "sin": sin_integral,
                 "end": (end_sin * cos_total - end_cos * sin_total) / omega,
                 "end_slope": end_cos * cos_total + end_sin * sin_total,
-                "tail": max(abs(a) for a in coefficients[-4:]) / scale,
-            })
+            }
         return out
 
     def _solve(self, order: int, release: list[Any], mu: Any, data: list[dict]) -> None:
@@ -561,8 +564,8 @@ class VectorArc:
         while True:  # the grid doubles until this order's forcing and the fixed orders are resolved
             with workdps(self._working), self._context():
                 tolerance = gmpy2.mpfr(10) ** (-(self.digits + 2))
-                data = self._particular(order)
-                if max(max(item["tail"] for item in data), self.tail) <= tolerance:
+                data = self._particular(order, tolerance) if self.tail <= tolerance else None
+                if data is not None:
                     self._pending = (order, data)
                     return [(_mpf(item["end"]), _mpf(item["end_slope"])) for item in data]
             self._refine(order)
