@@ -357,7 +357,8 @@ class VectorArc:
             self._projections = {(id(vector), 0): vector[self.mode] * cosine for vector in self._vectors}
             self._powers: dict[tuple, np.ndarray] = {}  # [(c·Y)^m]_n, [(y − y_0)^m]_n at the nodes
             self._taylor: dict[tuple[int, int], np.ndarray] = {}  # f^{(k)}(y_0)/k! of an analytic law at the nodes
-            self._series: list[list[np.ndarray]] = []  # Chebyshev coefficients of Y_{n,k}
+            self._series: list[list[np.ndarray]] = []  # Chebyshev coefficients of Y_{n,k} (node values before)
+            self._unresolved: list[int] = []  # orders whose _series still hold node values
             self.tail = gmpy2.mpfr(0)
 
     def _coefficients(self, values: np.ndarray, other: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None]:
@@ -494,7 +495,7 @@ class VectorArc:
     def _solve(self, order: int, release: list[Any], mu: Any, data: list[dict]) -> None:
         beta = self._beta
         resonant = beta**3 / 2 * mu
-        values_all, second_all, slopes_all, series = [], [], [], []
+        values_all, second_all, slopes_all = [], [], []
         for k in range(self.size):
             cosine, sine = self._trig[k]
             omega = self._omega[k]
@@ -512,13 +513,6 @@ class VectorArc:
             values_all.append(values)
             second_all.append(force - (omega * omega) * values)
             slopes_all.append(slopes)
-        for k in range(0, self.size, 2):  # two components a transform
-            pair = self._coefficients(*values_all[k:k + 2])
-            for value_series in pair[:len(values_all[k:k + 2])]:
-                series.append(value_series)
-                size = max(abs(a) for a in value_series)
-                if size:
-                    self.tail = max(self.tail, max(abs(a) for a in value_series[-4:]) / size)
         stacked = np.vstack(values_all)
         for vector in self._vectors:
             key = (id(vector), order)
@@ -536,7 +530,24 @@ class VectorArc:
             self._binomial.append(sum((((p + 1) * k - order) * (self._ratios_r[k] * self._binomial[order - k])
                                        for k in range(1, order + 1)), self._zero) / order)
         self._mu.append(mu)
-        self._series.append(series)
+        self._series.append(values_all)  # node values until their series are wanted (:meth:`_resolve`)
+        self._unresolved.append(order)
+
+    def _resolve(self) -> None:
+        """The Chebyshev series of the fixed orders' Y_{n,k} (two components a transform) and the largest relative
+        tail among them, ``self.tail`` — wanted by the next order's refinement test or by :meth:`series` only (the
+        last order of an expansion never pays for them unless its series are read)."""
+        for order in self._unresolved:
+            values_all, series = self._series[order - 1], []
+            for k in range(0, self.size, 2):
+                pair = self._coefficients(*values_all[k:k + 2])
+                for value_series in pair[:len(values_all[k:k + 2])]:
+                    series.append(value_series)
+                    size = max(abs(a) for a in value_series)
+                    if size:
+                        self.tail = max(self.tail, max(abs(a) for a in value_series[-4:]) / size)
+            self._series[order - 1] = series
+        self._unresolved = []
 
     def _refine(self, order: int) -> None:
         """Double the Chebyshev points and redo the fixed orders with their h_k and μ_n."""
@@ -564,6 +575,7 @@ class VectorArc:
         while True:  # the grid doubles until this order's forcing and the fixed orders are resolved
             with workdps(self._working), self._context():
                 tolerance = gmpy2.mpfr(10) ** (-(self.digits + 2))
+                self._resolve()
                 data = self._particular(order, tolerance) if self.tail <= tolerance else None
                 if data is not None:
                     self._pending = (order, data)
@@ -615,6 +627,7 @@ class VectorArc:
             raise ValueError(f"order {order} of the stretched arc is not fixed yet")
         with workdps(self._working), self._context():
             if order:
+                self._resolve()
                 key = (order, component)
                 if key not in self._slope_series:
                     self._slope_series[key] = self._coefficients(self._slopes[order - 1][component])[0]
