@@ -249,11 +249,21 @@ class _SparseProduct:
                 self.diagonals.append((slice(first, last), slice(first + offset, last + offset), column))
             else:
                 self.diagonals.append((rows_sorted, rows_sorted + offset, column))
+        # a diagonal meeting every row (the main one of a mass or stiffness matrix) first: it sets the result
+        def full(diagonal: tuple) -> bool:
+            return isinstance(diagonal[0], slice) and diagonal[0] == slice(0, n)
+
+        self.diagonals.sort(key=lambda diagonal: not full(diagonal))
+        self._full = bool(self.diagonals) and full(self.diagonals[0])
         self.n = n
 
     def times(self, columns: np.ndarray) -> np.ndarray:
-        result = np.full(columns.shape, _gmpy2().mpfr(0), dtype=object)
-        for rows, sources, values in self.diagonals:
+        diagonals = self.diagonals
+        if self._full:
+            result, diagonals = diagonals[0][2] * columns[diagonals[0][1]], diagonals[1:]
+        else:
+            result = np.full(columns.shape, _gmpy2().mpfr(0), dtype=object)
+        for rows, sources, values in diagonals:
             result[rows] += values * columns[sources]  # one entry per row on a diagonal
         return result
 
@@ -504,18 +514,19 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
         X = np.frompyfunc(gmpy2.mpfr, 1, 1)(np.asarray(float_modes.shapes, dtype=float))
         MX = product.times(X)
         previous: list[Any] | None = None
-        success, done, solves, change, last = False, 0, 0, math.inf, None
+        success, done, solves, change, last, last_cycle = False, 0, 0, math.inf, None, steps
         tolerance = gmpy2.mpfr(2) ** (-2 * target)
         with mpmath.workprec(bits):
             upper = gmpy2.mpfr(float(theta[-1]))  # the damped interval of K⁻¹M: [0, 1/θ_q]
             stiffness_product = _SparseProduct(stiffness, n)
+            cycle = steps  # the Chebyshev steps until the next Ritz step
             while done < _MAX_ITERATIONS:
                 # Y_j = T_j(2 θ_q K⁻¹M − I) X (Chebyshev: Y_{j+1} = 4 θ_q K⁻¹M Y_j − 2 Y_j − Y_{j−1})
                 before, Y = X, factor.solve(MX, 2 * upper) - X
-                for _ in range(steps - 1):
+                for _ in range(cycle - 1):
                     before, Y = Y, factor.solve(product.times(Y), 4 * upper) - 2 * Y - before
-                done += steps
-                solves += steps * columns
+                done += cycle
+                solves += cycle * columns
                 MY = product.times(Y)
                 values, transform = _ritz(Y.T.dot(stiffness_product.times(Y)), Y.T.dot(MY))
                 upper = values[-1]
@@ -523,14 +534,22 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
                 X = Y.dot(transform)
                 MX = product.times(X)  # O(N b q) against O(N q²) for MY·transform
                 if previous is not None:
+                    # the change is the previous values' error; theirs falls over s steps by the slower of T_s(x)⁻²,
+                    # x = 2θ_q/θ_K − 1, and the rate observed between the last two changes
                     change = max(abs(a - b) / abs(a) for a, b in zip(kept, previous))
-                    # the next change, at the slower of the observed rate and the one T_s(x_K)⁻² implies
                     x = 2 * values[-1] / values[K - 1] - 1
-                    ratio = max(1 / gmpy2.cosh(steps * gmpy2.acosh(x)) ** 2 if x > 1 else 1, change / last) if last else 1
-                    if change * ratio <= tolerance:
+                    observed = (change / last) ** (1 / last_cycle) if last else gmpy2.mpfr(0)
+
+                    def ratio(s: int) -> Any:
+                        return max(1 / gmpy2.cosh(s * gmpy2.acosh(x)) ** 2 if x > 1 else 1, observed**s)
+
+                    error = change * ratio(cycle)
+                    if error <= tolerance:
                         success = True
                         break
-                    last = change
+                    last, last_cycle = change, cycle
+                    # the next Ritz step after the steps that should bring the error to a quarter of the tolerance
+                    cycle = next((s for s in range(1, steps) if error * ratio(s) <= tolerance / 4), steps)
                 previous = kept
                 checkpoint("subspace iteration", done, _MAX_ITERATIONS)
             # K X by the sparse product: it cancels log2 cond(K) bits, which the working precision holds in reserve
@@ -580,7 +599,7 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
         frequencies = tuple(+value for value in frequencies)
     message = (f"{K} modes converged to {method.digits} digits in {done} subspace iterations" if success else
                f"the Ritz values were still moving after {done} subspace iterations (by {float(change):.1e} relative in the last "
-               f"{steps}): the kept modes are not converged to {method.digits} digits, so a kept mode's ω₀, ω₁ are not the "
+               f"{last_cycle}): the kept modes are not converged to {method.digits} digits, so a kept mode's ω₀, ω₁ are not the "
                "full model's to that precision (keep fewer modes, or more: a step gains a factor (x + √(x² − 1))² with "
                "x = 2λ_q/λ_K − 1)")
     if not success:
@@ -622,7 +641,8 @@ def _forward(lower: np.ndarray, right: np.ndarray) -> np.ndarray:
 def _eigen(matrix: np.ndarray) -> tuple[list[Any], np.ndarray]:
     """The eigenpairs of a small symmetric object matrix of mpfr at the context's precision: values increasing,
     vectors orthonormal.  The float64 eigenvectors, orthonormalised (Cholesky QR), leave off-diagonal entries of
-    ~1e-16 ‖C‖ that cyclic Jacobi sweeps square away (quadratic convergence, clusters included)."""
+    ~1e-16 ‖C‖ that cyclic Jacobi sweeps square away (quadratic convergence, clusters included) until the
+    diagonal holds the eigenvalues to the working precision (the vectors then to about half of it)."""
     gmpy2 = _gmpy2()
     size = matrix.shape[0]
     to_mpfr = np.vectorize(gmpy2.mpfr, otypes=[object])
@@ -632,6 +652,11 @@ def _eigen(matrix: np.ndarray) -> tuple[list[Any], np.ndarray]:
     D = (D + D.T) / 2
     floor = gmpy2.mpfr(2) ** (-gmpy2.get_context().precision)
     for _ in range(_MAX_SWEEPS):
+        # done when each diagonal entry is an eigenvalue to the working precision: its second-order shift
+        # d_pq² / (d_pp − d_qq) below 2^-p of the scale (and a clustered pair, whose shift is first order, rotated)
+        if all(D[p, q] ** 2 <= floor * (abs(D[p, p]) + abs(D[q, q])) * abs(D[p, p] - D[q, q])
+               for p in range(size - 1) for q in range(p + 1, size)):
+            break
         rotated = False
         for p in range(size - 1):
             for q in range(p + 1, size):
