@@ -40,9 +40,15 @@ powers (1 − τ)^{k/d} that the contact point brings are powers of v, and τ = 
 so it is kept by its values at M Chebyshev points of the first kind in v (interior
 points: R_m is 0/0 at v = 0) and the integrals are cumulative Chebyshev integrals in v
 (t = 1 − ν^d, dt = −d ν^{d−1} dν), which converge geometrically.  M doubles until
-the Chebyshev tail of every component of every Y_n is below the working precision.  Arithmetic is mpmath
-at the requested digits plus guard digits (the quotient R_m near v = 0 loses up to
-log10(1/v_min^d) of them).
+the Chebyshev tail of every component of every Y_n is below the working precision.  Arithmetic is at the
+requested digits plus guard digits (the quotient R_m near v = 0 loses up to log10(1/v_min^d) of them): node
+values are numpy object arrays of gmpy2 ``mpfr`` at mpmath's working precision (correctly rounded like mpmath's
+mpf, a tenth of the cost through mpmath's Python layer), the transforms fixed-point integers
+(:class:`_FixedPointTransform`, two vectors a transform).  Only what later orders read is kept per order: the
+projections ``c·Y_n`` of the laws' vectors, ``Y_n''`` and ``Y_n'`` per component at the nodes, and Y_n's node
+values until their Chebyshev series are wanted (then the series).  Measured on the reduced 1000-dof chain (13
+components, 1024 points, order 2): the arc 0.70 s CPU where the mpmath arc took 3.9 s; a 200-dof chain's arc
+(200 components, 512 points) 5.7 s and 83 MB where it took 28 s and 266 MB.
 """
 
 from __future__ import annotations
