@@ -137,10 +137,17 @@ class _FixedPointTransform:
         chirp = [table[(-2 * m * m) % period] for m in range(-(size - 1), size)]
         # digits of the packed convolutions: |g| < 2^(bits+2), |chirp| < 2^(bits+1), M terms, a sign
         self._width = 2 * bits + size.bit_length() + 6
-        self._chirp = [_pack(part, self._width) for part in ([c for c, _ in chirp], [c_s for _, c_s in chirp],
-                                                              [c + c_s for c, c_s in chirp])]
-        half = 1 << (self._width - 1)
-        self._half, self._lift = half, gmpy2.pack([half] * (3 * size - 2), self._width)  # signed digits read back
+        width = self._width
+        self._chirp = [_pack(part, width) for part in ([c for c, _ in chirp], [c_s for _, c_s in chirp],
+                                                        [c + c_s for c, c_s in chirp])]
+        # the data go in lifted by 2^(bits+3) (|g| < 2^(bits+2): one unsigned pack), their digits come back lifted
+        # by 2^(width−1) (unsigned for gmpy2.unpack); one constant per chirp part takes the first lift out and puts
+        # the second in: lift − 2^(bits+3) Σ_i chirp_{k−i}
+        self._offset = 1 << (bits + 3)
+        ones = gmpy2.pack([self._offset] * size, width)
+        self._half = 1 << (width - 1)
+        lift = gmpy2.pack([self._half] * (3 * size - 2), width)
+        self._correction = [lift - ones * part for part in self._chirp]
         self._negated = (-np.arange(size)) % size  # −k mod M
         self._reversed = np.concatenate([[0], np.arange(size - 1, 0, -1)])  # M − k, with b_M = 0 read at k = 0
 
@@ -164,13 +171,13 @@ class _FixedPointTransform:
         else:
             g_real = (real * c - imaginary * s_) >> bits
             g_imaginary = (real * s_ + imaginary * c) >> bits
-        width, half = self._width, self._half
+        width, offset = self._width, self._offset
         products = []
-        for g, chirp in zip((g_real, g_imaginary, g_real + g_imaginary), self._chirp):
-            digits = gmpy2.unpack(_pack(g, width) * chirp + self._lift, width)
-            products.append(_array(digits[size - 1:2 * size - 1]) - half)
+        for g, chirp, correction in zip((g_real, g_imaginary, g_real + g_imaginary), self._chirp, self._correction):
+            digits = gmpy2.unpack(gmpy2.pack(list(g + offset), width) * chirp + correction, width)
+            products.append(_array(digits[size - 1:2 * size - 1]))  # each lifted by 2^(width−1)
         first, second, third = products
-        return first - second, third - first - second
+        return first - second, third - first - second + self._half
 
     def forward(self, a: np.ndarray, b: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None]:
         """(T a, T b)."""
