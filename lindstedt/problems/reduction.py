@@ -194,37 +194,40 @@ class _BandedLDL:
             diagonal.append(total)
             lower.append(entries_i)
         # the band of L by rows (forward sweep) and by columns (Lᵀ sweep) as small object arrays: one dot per row
-        self._rows: list[tuple[int, np.ndarray]] = []
+        # (rows and columns of L with no entry off the diagonal left out)
+        self._rows: list[tuple[int, int, np.ndarray]] = []
         by_column: list[list[tuple[int, Any]]] = [[] for _ in range(n)]
         for i, entries in enumerate(lower):
-            start = entries[0][0] if entries else i
-            coefficients = [zero] * (i - start)
-            for j, l_ij in entries:
-                coefficients[j - start] = l_ij
-                by_column[j].append((i, l_ij))
-            self._rows.append((start, np.array(coefficients, dtype=object)))
-        self._columns: list[tuple[int, np.ndarray]] = []
-        for j, entries in enumerate(by_column):
-            stop = entries[-1][0] + 1 if entries else j + 1
-            coefficients = [zero] * (stop - j - 1)
-            for i, l_ij in entries:
-                coefficients[i - j - 1] = l_ij
-            self._columns.append((stop, np.array(coefficients, dtype=object)))
+            if entries:
+                start = entries[0][0]
+                coefficients = [zero] * (i - start)
+                for j, l_ij in entries:
+                    coefficients[j - start] = l_ij
+                    by_column[j].append((i, l_ij))
+                self._rows.append((i, start, np.array(coefficients, dtype=object)))
+        self._columns: list[tuple[int, int, np.ndarray]] = []
+        for j in range(n - 1, -1, -1):  # in the order of the Lᵀ sweep
+            if by_column[j]:
+                stop = by_column[j][-1][0] + 1
+                coefficients = [zero] * (stop - j - 1)
+                for i, l_ij in by_column[j]:
+                    coefficients[i - j - 1] = l_ij
+                self._columns.append((j, stop, np.array(coefficients, dtype=object)))
         self._diagonal = np.array(diagonal, dtype=object)[:, None]
 
     def solve(self, columns: np.ndarray, scale: Any = 1) -> np.ndarray:
         """``scale · S⁻¹ columns`` for an (n, c) object array of mpfr (one small dot per row and sweep: the band's
         entries of a row, or of a column of L, against the rows of the right-hand side they meet; ``scale`` joins
         the division by D)."""
-        y = columns[self.order].copy()
-        for i, (start, coefficients) in enumerate(self._rows):
-            if start < i:
-                y[i] = y[i] - coefficients.dot(y[start:i])
+        subtract = np.subtract
+        y = columns[self.order]
+        for i, start, coefficients in self._rows:  # L: y_i = c_i − Σ_{j < i} L[i, j] y_j, in place
+            row = y[i]
+            subtract(row, coefficients.dot(y[start:i]), out=row)
         y = y / self._diagonal if scale == 1 else y * (scale / self._diagonal)
-        for j in range(self.n - 1, -1, -1):  # Lᵀ: x_j = y_j − Σ_{i > j} L[i, j] x_i
-            stop, coefficients = self._columns[j]
-            if stop > j + 1:
-                y[j] = y[j] - coefficients.dot(y[j + 1:stop])
+        for j, stop, coefficients in self._columns:  # Lᵀ: x_j = y_j − Σ_{i > j} L[i, j] x_i
+            row = y[j]
+            subtract(row, coefficients.dot(y[j + 1:stop]), out=row)
         result = np.empty_like(y)
         result[self.order] = y
         return result
@@ -275,6 +278,16 @@ def _dense(entries: dict[tuple[int, int], Any], shape: tuple[int, int], transpos
     for (i, j), value in entries.items():
         array[(j, i) if transposed else (i, j)] = _mpfr(value)
     return array
+
+
+def _gram(left: np.ndarray, right: np.ndarray) -> np.ndarray:
+    """``leftᵀ right`` known to be symmetric (``Vᵀ M V``): its upper triangle, mirrored (half the products)."""
+    size = left.shape[1]
+    result = np.empty((size, size), dtype=object)
+    for a in range(size):
+        result[a, a:] = left[:, a].dot(right[:, a:])
+        result[a + 1:, a] = result[a, a + 1:]
+    return result
 
 
 def _rows_times(entries: dict[tuple[int, int], Any], rows: int, columns: np.ndarray) -> np.ndarray:
@@ -524,11 +537,11 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
                 # Y_j = T_j(2 θ_q K⁻¹M − I) X (Chebyshev: Y_{j+1} = 4 θ_q K⁻¹M Y_j − 2 Y_j − Y_{j−1})
                 before, Y = X, factor.solve(MX, 2 * upper) - X
                 for _ in range(cycle - 1):
-                    before, Y = Y, factor.solve(product.times(Y), 4 * upper) - 2 * Y - before
+                    before, Y = Y, factor.solve(product.times(Y), 4 * upper) - (Y + Y) - before
                 done += cycle
                 solves += cycle * columns
                 MY = product.times(Y)
-                values, transform = _ritz(Y.T.dot(stiffness_product.times(Y)), Y.T.dot(MY))
+                values, transform = _ritz(_gram(Y, stiffness_product.times(Y)), _gram(Y, MY))
                 upper = values[-1]
                 kept = values[:K]
                 X = Y.dot(transform)
@@ -577,8 +590,8 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
             Z, KZ = Z * signs, KZ * signs
             MZ = product.times(Z)
             V, KV, MV = (np.hstack(pair) for pair in ((X, Z), (KX, KZ), (MX, MZ)))
-            reduced_mass = V.T.dot(MV)
-            reduced_stiffness = V.T.dot(KV)
+            reduced_mass = _gram(V, MV)
+            reduced_stiffness = _gram(V, KV)
             reduced_A = _rows_times(elements, m, V)  # A V, Wᵀ V and Pᵀ V from the few nonzero entries
             reduced_W = (reduced_A if forces is None else
                          _rows_times({(j, i): value for (i, j), value in forces.items()}, m, V)).T
