@@ -64,10 +64,10 @@ from .system import UnilateralSystem
 __all__ = ["ResidualFlexibility", "ReducedStructure"]
 
 #: CPU seconds of one multiprecision operation of the reduction (gmpy2 mpfr in numpy object arrays, ~360 bits),
-#: fitted to the measured CPU time of the operation count of :meth:`ResidualFlexibility.estimate` (at the
-#: iterations done): 1.4e-7 on a chain of 1000 and 2000 dof (b = 1), 1.4e-7 to 1.6e-7 on beams of 400 and 1000
-#: dof (b = 4), the fixed costs (float modes, imports) making small models dearer per operation
-_SECONDS_PER_OPERATION = 1.5e-7
+#: fitted to the measured CPU time of the operation count of :meth:`ResidualFlexibility.estimate` at the
+#: iterations done: 1.15e-7 and 1.35e-7 on a chain of 1000 and 2000 dof (b = 1), 1.25e-7 on beams of 400 and
+#: 1000 dof (b = 4); the float modes, the checks and imports make small models dearer per operation
+_SECONDS_PER_OPERATION = 1.3e-7
 _MAX_ITERATIONS = 60
 #: Chebyshev steps between two Ritz steps at most, and the bits held in reserve for the columns' drift between them
 _MAX_STEPS = 8
@@ -534,10 +534,13 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
             stiffness_product = _SparseProduct(stiffness, n)
             cycle = steps  # the Chebyshev steps until the next Ritz step
             while done < _MAX_ITERATIONS:
-                # Y_j = T_j(2 θ_q K⁻¹M − I) X (Chebyshev: Y_{j+1} = 4 θ_q K⁻¹M Y_j − 2 Y_j − Y_{j−1})
-                before, Y = X, factor.solve(MX, 2 * upper) - X
+                # Y_j = T_j(2 θ_q K⁻¹M − I) X: Y_{j+1} = 4 θ_q K⁻¹M Y_j − 2 Y_j − Y_{j−1}, carried by the sums
+                # S_j = Y_j + Y_{j−1} (S_{j+1} = 4 θ_q K⁻¹M Y_j − S_j, Y_{j+1} = S_{j+1} − Y_j: two subtractions a step)
+                total = factor.solve(MX, 2 * upper)
+                Y = total - X
                 for _ in range(cycle - 1):
-                    before, Y = Y, factor.solve(product.times(Y), 4 * upper) - (Y + Y) - before
+                    total = factor.solve(product.times(Y), 4 * upper) - total
+                    Y = total - Y
                 done += cycle
                 solves += cycle * columns
                 MY = product.times(Y)
