@@ -124,7 +124,7 @@ def _entries(matrix: Any, rows: int, cols: int, name: str) -> dict[tuple[int, in
             array = np.asarray(matrix)
             if array.dtype == object or not np.issubdtype(array.dtype, np.number) or np.iscomplexobj(array):
                 raise ProblemError(f"{name} must be a real numeric matrix (numpy, scipy.sparse or sympy), got {matrix!r:.80}")
-            coo = scipy.sparse.coo_matrix(np.atleast_2d(array).astype(float))
+            coo = scipy.sparse.coo_matrix(np.asarray(np.atleast_2d(array), dtype=float))  # no copy of a float array
         if coo.shape != (rows, cols):
             raise ProblemError(f"{name} is {coo.shape[0]}×{coo.shape[1]}, expected {rows}×{cols}")
         if np.iscomplexobj(coo.data) or not np.all(np.isfinite(coo.data)):
@@ -662,7 +662,8 @@ def _eigen(matrix: np.ndarray) -> tuple[list[Any], np.ndarray]:
     gmpy2 = _gmpy2()
     size = matrix.shape[0]
     to_mpfr = np.vectorize(gmpy2.mpfr, otypes=[object])
-    Q = to_mpfr(np.linalg.eigh(matrix.astype(float))[1])
+    largest = max(abs(value) for value in matrix.ravel()) or 1  # float64 sees the matrix scaled to 1
+    Q = to_mpfr(np.linalg.eigh((matrix / largest).astype(float))[1])
     Q = _forward(_cholesky(Q.T.dot(Q)), Q.T).T  # Q R⁻¹, R = chol(QᵀQ)ᵀ: orthonormal to the working precision
     D = Q.T.dot(matrix).dot(Q)
     D = (D + D.T) / 2
