@@ -402,7 +402,10 @@ def sparse_modes(M: Any, K: Any, count: int, *, sigma: float = 0.0) -> Modes:
     if isinstance(sigma, bool) or not isinstance(sigma, (int, float)) or not np.isfinite(sigma):
         raise ProblemError(f"sigma must be a finite real number (a shift of λ²), got {sigma!r}")
     try:
-        squared, shapes = eigsh(stiffness, k=int(count), M=mass, sigma=float(sigma), which="LM", tol=0.0)
+        # a fixed start vector: ARPACK's default is a fresh random one per call, and the modes' last bits (and every
+        # exact result refined from them: ResidualFlexibility's reduced data below 1e-30) changed from run to run
+        start = np.random.default_rng(20261127).uniform(-1.0, 1.0, n)
+        squared, shapes = eigsh(stiffness, k=int(count), M=mass, sigma=float(sigma), which="LM", tol=0.0, v0=start)
     except RuntimeError as error:  # a singular K − σ M ("Factor is exactly singular")
         raise ProblemError(f"K − sigma·M is singular at sigma = {sigma} ({error}); the structure is a mechanism "
                            "(fix its supports) or sigma is an eigenvalue (move it)") from None
