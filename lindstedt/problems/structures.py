@@ -41,7 +41,8 @@ SYMMETRY_RTOL = 1e-12
 MAX_FILE_BYTES = 1 << 28
 
 _SUFFIXES = (".npz", ".npy", ".mat", ".mtx")
-_DENSE_CHOLESKY_MAX = 2000  # a sparse M up to this size is checked by a dense Cholesky
+_DENSE_CHOLESKY_MAX = 200  # a sparse M up to this size is checked by a dense Cholesky (measured: dense 0.54 ms, sparse LDLᵀ
+# 0.17 ms at 200 dof; 21 ms against 0.32 ms at 1000, and the dense copy is N² memory)
 
 
 def _sparse():
