@@ -70,7 +70,7 @@ from ..algebra.cosine import _pack
 __all__ = ["FloatArc", "VectorArc"]
 
 _INITIAL_NODES = 32
-_MAXIMUM_NODES = 1024
+_MAXIMUM_NODES = 4096
 _GUARD_DIGITS = 20
 _TWO = gmpy2.mpfr(2)
 
@@ -110,7 +110,7 @@ class _FixedPointTransform:
     one complex convolution with the chirp ``W^{−m²}`` — three integer convolutions (Karatsuba), each one GMP product
     of Kronecker-packed vectors (:func:`~lindstedt.algebra.cosine._pack`).  Each input vector is scaled to integers
     relative to its own largest entry (the split is linear) and the roots of unity to 2^bits; the rounding adds
-    ~8 M 2^-bits of that entry (the guard bits cover M ≤ 1024 twice over).  Only the 4M values of ``e^{−iπe/(2M)}``
+    ~8 M 2^-bits of that entry (the guard bits cover it with 15 bits to spare).  Only the 4M values of ``e^{−iπe/(2M)}``
     are computed, not the M² entries of T.  The per-node work is numpy object arrays of gmpy2 integers; in and out
     go gmpy2 mpfr at the caller's gmpy2 precision.  Measured at 61 digits, M = 1024 (a loaded 2-core machine, CPU
     time): two transforms 9–10 ms, one as a length-M Bluestein DCT 7–9.5 ms; ~4 ms are the three GMP products.
@@ -120,7 +120,8 @@ class _FixedPointTransform:
         if size % 2:
             raise ValueError("the fixed-point Chebyshev transform needs an even number of points")
         self.size = size
-        bits = self.bits = int(digits * 3.33) + 28
+        # rounding ~8 M 2^-bits of an entry (M = 2^m): m + 3 bits, and 15 bits of margin (28 guard bits up to M = 1024)
+        bits = self.bits = int(digits * 3.33) + max(28, size.bit_length() + 17)
         period = 4 * size  # e^{−iπe/(2M)} depends on e mod 4M
         with gmpy2.context(precision=bits + 20):
             angle = gmpy2.const_pi() / (2 * size)
