@@ -429,6 +429,9 @@ class _Builder:
 #: texts that passed every check are kept.
 _PARSED: dict[tuple[Any, ...], sympy.Basic] = {}
 _PARSED_SIZE = 256
+#: the texts of :data:`_PARSED` → (their syntax node count, the names their tree uses): a text read before is
+#: looked up without parsing it again (bounded and cleared with it)
+_SHAPES: dict[str, tuple[int, tuple[str, ...]]] = {}
 
 
 @locked
@@ -497,26 +500,37 @@ def _parse_text(text: str, symbols: Mapping[str, sympy.Expr], what: str) -> symp
     if not text.strip():
         raise ProblemError(f"{what} is empty; give an expression such as 'u**3'")
     source = text.strip().replace("^", "**")
-    try:
-        tree = ast.parse(source, mode="eval")
-    except (SyntaxError, ValueError, RecursionError, MemoryError) as error:
-        reason = getattr(error, "msg", None) or type(error).__name__
-        raise ProblemError(f"cannot parse {what} = {text!r}: {reason}; {_GRAMMAR_HINT}") from None
-    count = sum(1 for _ in ast.walk(tree))
+    shape, tree = _SHAPES.get(source), None
+    if shape is None:
+        try:
+            tree = ast.parse(source, mode="eval")
+        except (SyntaxError, ValueError, RecursionError, MemoryError) as error:
+            reason = getattr(error, "msg", None) or type(error).__name__
+            raise ProblemError(f"cannot parse {what} = {text!r}: {reason}; {_GRAMMAR_HINT}") from None
+        count, found = 0, set()
+        for node in ast.walk(tree):
+            count += 1
+            if isinstance(node, ast.Name):
+                found.add(node.id)
+        shape = (count, tuple(sorted(found)))
+    count, names = shape
     if count > LIMITS.nodes:
         raise ProblemError(f"{what} has {count} syntax nodes, more than the bound of {LIMITS.nodes}; simplify it")
-    names = sorted({node.id for node in ast.walk(tree) if isinstance(node, ast.Name)})
     key = (source, what, LIMITS, tuple((name, symbols.get(name)) for name in names))
     expression = _PARSED.get(key)
     if expression is not None:
         return expression
+    if tree is None:
+        tree = ast.parse(source, mode="eval")
     try:
         expression = _Builder(source, symbols, what).build(tree)
     except RecursionError:  # pragma: no cover - the depth bound comes first
         raise ProblemError(f"{what} is nested too deeply; simplify it") from None
     if len(_PARSED) >= _PARSED_SIZE:
         _PARSED.clear()
+        _SHAPES.clear()
     _PARSED[key] = expression
+    _SHAPES[source] = shape
     return expression
 
 
@@ -594,6 +608,12 @@ def parse_real(value: Any, *, what: str) -> sympy.Expr:
             raise ProblemError(f"{what} must be a finite real number such as 1, 0.5, '1/3' or 'sqrt(2)', got {value!r}") from None
     else:
         number = as_exact(value, what=what)
+    if isinstance(number, sympy.Rational):  # exact, finite and real: its magnitude checked in integers
+        numerator, denominator = abs(int(number.p)), int(number.q)
+        if numerator and not (denominator <= numerator << 1074
+                              and numerator * _LARGEST_MAGNITUDE.q <= _LARGEST_MAGNITUDE.p * denominator):
+            raise ProblemError(_beyond_float(what, value))
+        return number
     if not isinstance(number, sympy.Expr) or number.free_symbols or not number.is_number:
         raise ProblemError(f"{what} must be a finite real number such as 1, 0.5, '1/3' or 'sqrt(2)', got {value!r}")
     if number.has(sympy.zoo, sympy.oo, -sympy.oo, sympy.nan) or number.is_finite is False:
@@ -605,10 +625,13 @@ def parse_real(value: Any, *, what: str) -> sympy.Expr:
     if number != 0:
         size = abs(number) if number.is_Rational else abs(sympy.N(number, 15))
         if not _SMALLEST_MAGNITUDE <= size <= _LARGEST_MAGNITUDE:
-            raise ProblemError(f"{what} = {value!r} is beyond the range of a float (magnitudes 5e-324 to 1.8e308), where "
-                               "the numerics and the float evaluators cannot follow; rescale the problem (choose units "
-                               "in which it is of order one)")
+            raise ProblemError(_beyond_float(what, value))
     return number
+
+
+def _beyond_float(what: str, value: Any) -> str:
+    return (f"{what} = {value!r} is beyond the range of a float (magnitudes 5e-324 to 1.8e308), where the numerics "
+            "and the float evaluators cannot follow; rescale the problem (choose units in which it is of order one)")
 
 
 #: The magnitudes a number of a problem may have: those of a finite float, from the smallest subnormal to the
