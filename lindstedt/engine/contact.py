@@ -100,7 +100,9 @@ class PiecewiseNormalForm:
 
     def scaled_expr(self, element: Any, power: int, prefactor: sympy.Expr) -> sympy.Expr:
         """``prefactor · (1/ω0²)^(power/gauge) · element`` in the problem's symbols (η^power = (ε/ω0²)^(power/gauge))."""
-        scale = self.epsilon_scale ** sympy.Rational(power, self.gauge)
+        scale = self.epsilon_scale
+        if scale is not sympy.S.One:  # 1^r is 1
+            scale = scale ** sympy.Rational(power, self.gauge)
         if prefactor is sympy.S.One and scale is sympy.S.One and element:  # ω0 = 1: 1 · 1 · x is x (a zero
             return self.to_expr(element)                                   # Float becomes sympy's 0 in the product)
         return prefactor * scale * self.to_expr(element)
@@ -245,6 +247,13 @@ class _FloatField(RealField):
             total = mpf_add(total, value, prec, rounding)
         return self._context.make_mpf(total)
 
+    def to_sympy(self, element: Any) -> sympy.Float:
+        """``Float(element, dps)`` built from the raw value (the same number: an element has the field's precision)."""
+        precision = self.__dict__.get("_float_precision")
+        if precision is None:
+            precision = self.__dict__["_float_precision"] = mpmath.libmp.dps_to_prec(self.dps)
+        return sympy.Float._new(mpf_pos(element._mpf_, precision, round_nearest), precision, zero=False)
+
     def from_raw(self, value: tuple) -> Any:
         """The element nearest to mpmath's raw value ``value`` (any precision)."""
         return self._context.make_mpf(mpf_pos(value, self._context.prec, round_nearest))
@@ -329,9 +338,16 @@ def _intervals(problem: Oscillator) -> list[PolynomialInterval]:
             _SYMBOLIC_INTERVALS[problem.f] = symbolic
         symbolic = _SYMBOLIC_INTERVALS[problem.f]
         intervals = []
+        def put(value: sympy.Expr) -> sympy.Expr:  # value.xreplace(values), read directly for a number or a symbol
+            if value.is_Rational:
+                return value
+            if value.is_Symbol:
+                return values.get(value, value)
+            return value.xreplace(values)
+
         for interval in symbolic or ():
-            lower, upper = (None if end is None else end.xreplace(values) for end in (interval.lower, interval.upper))
-            coefficients = [coefficient.xreplace(values) for coefficient in interval.coefficients]
+            lower, upper = (None if end is None else put(end) for end in (interval.lower, interval.upper))
+            coefficients = [put(coefficient) for coefficient in interval.coefficients]
             while len(coefficients) > 2 and coefficients[-1] == 0:
                 coefficients.pop()
             if not all(isinstance(value, sympy.Rational) for value in [lower, upper, *coefficients] if value is not None):
@@ -358,17 +374,24 @@ def contact_normal_form(problem: Oscillator, digits: int | None = None, order_hi
     # w-breakpoints κ_i = u_i / a0, and the law f̂(w) = f(a0 w)/a0 = Σ_m c_m a0^{m−1} w^m on each interval.
     # A fractional term c |u − b|^p becomes c |a0|^p |w − κ|^p / a0, κ = b/a0.
     w_intervals: list[tuple[sympy.Expr | None, sympy.Expr | None, tuple[sympy.Expr, ...], tuple]] = []
+    unit = amplitude is sympy.S.One  # a0 = 1: w = u (every product and quotient by a0 below would return its operand)
     for interval in intervals:
-        lower = None if interval.lower is None else interval.lower / amplitude
-        upper = None if interval.upper is None else interval.upper / amplitude
+        lower, upper = interval.lower, interval.upper
+        if unit:
+            law, fractional = tuple(interval.coefficients), tuple(interval.fractional)
+        else:
+            lower = None if lower is None else lower / amplitude
+            upper = None if upper is None else upper / amplitude
+            law = tuple(coefficient * amplitude ** (power - 1) for power, coefficient in enumerate(interval.coefficients))
+            fractional = tuple(
+                (coefficient * abs(amplitude) ** exponent / amplitude, point / amplitude, exponent)
+                for coefficient, point, exponent in interval.fractional
+            )
         if sign < 0:
             lower, upper = upper, lower
-        law = tuple(coefficient * amplitude ** (power - 1) for power, coefficient in enumerate(interval.coefficients))
-        fractional = tuple(
-            (coefficient * abs(amplitude) ** exponent / amplitude, point / amplitude, exponent)
-            for coefficient, point, exponent in interval.fractional
-        )
-        analytic = interval.analytic.subs(DISPLACEMENT, amplitude * _ARC_VARIABLE) / amplitude  # g(w) = g_u(a0 w)/a0
+        analytic = interval.analytic
+        if analytic != 0:
+            analytic = analytic.subs(DISPLACEMENT, amplitude * _ARC_VARIABLE) / amplitude  # g(w) = g_u(a0 w)/a0
         w_intervals.append((lower, upper, law, fractional, analytic))
     if sign < 0:
         w_intervals.reverse()
