@@ -53,10 +53,14 @@ Coefficients live in any sympy field: exact (``QQ``, ``QQ(π, κ, β, …)``) or
 from __future__ import annotations
 
 import math
+from bisect import bisect_left, bisect_right
+from itertools import repeat
 from dataclasses import dataclass
 from typing import Any, Sequence
 
 
+import gmpy2
+from mpmath.libmp import from_man_exp
 from sympy import QQ
 
 from ..algebra.branch import Branch, EvaluationPoint, domain_constant
@@ -175,6 +179,122 @@ def _subtract(terms: dict, branch: Branch, factor: Any = None) -> None:
             terms[key] = terms[key] + value if key in terms else value
 
 
+def _to_mpfr(value: Any) -> Any:
+    """A float field's element (or an int) as a gmpy2 mpfr, exactly (in a gmpy2 context of the field's precision)."""
+    if isinstance(value, int):
+        return gmpy2.mpfr(value)
+    sign, mantissa, exponent, _ = value._mpf_
+    result = gmpy2.mul_2exp(gmpy2.mpfr(mantissa), exponent)
+    return -result if sign else result
+
+
+class _SharedForcing:
+    """A part S of an order's right-hand sides that every component k receives with its own weight, −g_k S: a
+    rank-one projection ``c · W`` or an element's force (the laws couple the components only through them).
+
+    A component's particular solution of ``v'' + r_k² v = S`` has, for a term ``a trig(ν s)`` (ν ≠ r_k), the term
+    ``a / (r_k² − ν²) trig(ν s)``: its values and slopes at a point are ``Σ_t u_t / (r_k² − ν_t²)`` over the
+    products ``u_t = a_t trig_t(s0)`` (or ``a_t trig_t'(s0)``), formed once per point for every component — O(|S|)
+    per component and point in gmpy2 at the field's precision (each product and quotient rounded as the field
+    rounds it, the sum correctly rounded), no branch per component.  The other terms (powers of s, ν near r_k) go
+    to the component's own right-hand side.  Float fields only (with ``from_raw``).
+    """
+
+    __slots__ = ("domain", "context", "simple", "floats", "squares", "others", "_products")
+
+    def __init__(self, domain: Any, branch: Branch):
+        self.domain = domain
+        self.context = gmpy2.context(precision=domain.precision)
+        self.simple = [(key, value) for key, value in branch.terms.items() if not key[2]]
+        self.floats = sorted((float(key[0]), t) for t, (key, _) in enumerate(self.simple))  # (ν_t, t) by ν
+        with gmpy2.local_context(self.context):
+            self.squares = [_to_mpfr(key[0] * key[0]) for key, _ in self.simple]  # ν² rounded as the field rounds it
+        self.others = [(key, value) for key, value in branch.terms.items() if key[2]]
+        self._products: dict[tuple[EvaluationPoint, bool], list[Any]] = {}
+
+    def near(self, ratio: float, distance: float) -> list[int]:
+        """The indices t with |ν_t − r| ≤ distance (bisection of the sorted harmonics)."""
+        start = bisect_left(self.floats, (ratio - distance, -1))
+        stop = bisect_right(self.floats, (ratio + distance, len(self.floats)))
+        return [t for _, t in self.floats[start:stop]]
+
+    def inverses(self, ratio: Any, near: list[int]) -> list[Any]:
+        """``1/(r² − ν_t²)`` for every simple term (mpfr; zero at the indices ``near``, solved by the component)."""
+        with gmpy2.local_context(self.context):
+            squared = _to_mpfr(ratio * ratio)
+            result = list(map(gmpy2.div, repeat(gmpy2.mpfr(1), len(self.squares)), map(gmpy2.sub, repeat(squared),
+                                                                                          self.squares)))
+            for t in near:
+                result[t] = gmpy2.mpfr(0)
+        return result
+
+    def products(self, point: EvaluationPoint, slope: bool) -> list[Any]:
+        """``a_t trig_t(s0)`` (``slope``: ``a_t trig_t'(s0)``) for every simple term (mpfr), remembered per point."""
+        key = (point, slope)
+        cached = self._products.get(key)
+        if cached is None:
+            cached = []
+            for (harmonic, parity, _), value in self.simple:
+                if slope:  # (cos ν s)' = −ν sin ν s, (sin ν s)' = ν cos ν s
+                    trig = point.sin_multiple(harmonic) if parity == 0 else point.cos_multiple(harmonic)
+                    factor = domain_constant(self.domain, harmonic) if isinstance(harmonic, int) else harmonic
+                    product = -(value * factor * trig) if parity == 0 else value * factor * trig
+                else:
+                    product = value * (point.cos_multiple(harmonic) if parity == 0 else point.sin_multiple(harmonic))
+                cached.append(product)
+            with gmpy2.local_context(self.context):
+                cached = [_to_mpfr(product) for product in cached]
+            self._products[key] = cached
+        return cached
+
+    def solution_at(self, inverses: list[Any], point: EvaluationPoint, slope: bool) -> Any:
+        """Σ_t u_t/(r² − ν_t²) at ``point`` (a field element) for the inverses of one component."""
+        with gmpy2.local_context(self.context):
+            total = gmpy2.fsum(map(gmpy2.mul, self.products(point, slope), inverses))
+        mantissa, exponent = total.as_mantissa_exp()
+        return self.domain.from_raw(from_man_exp(int(mantissa), int(exponent)))
+
+
+class _Particular:
+    """A particular solution of ``v'' + r_k² v = own − Σ_S g_k S`` for one component k on one piece (the shared parts
+    S as :class:`_SharedForcing`): its values and slopes at points for the order's matching, and its branch, formed
+    only when the order's branches are asked for (the frequency needs none of the highest order's)."""
+
+    __slots__ = ("domain", "own", "shared", "_slope")
+
+    def __init__(self, domain: Any, own: Branch, shared: list[tuple[Any, _SharedForcing, list[Any]]]):
+        self.domain = domain
+        self.own = own  # the particular solution of the component's own right-hand side
+        self.shared = shared  # (−g_k, S, the inverses 1/(r_k² − ν²) of S's simple terms, zero where solved in own)
+        self._slope: Branch | None = None
+
+    def value(self, point: EvaluationPoint, slope: bool) -> Any:
+        """The particular solution (``slope``: its derivative) at ``point``."""
+        if slope:
+            if self._slope is None:
+                self._slope = self.own.derivative()
+            total = self._slope.evaluate(point)
+        else:
+            total = self.own.evaluate(point)
+        for weight, forcing, inverses in self.shared:
+            total = total + weight * forcing.solution_at(inverses, point, slope)
+        return total
+
+    def branch(self) -> Branch:
+        """The particular solution as a branch."""
+        if not self.shared:
+            return self.own
+        terms = dict(self.own.terms)
+        domain = self.domain
+        for weight, forcing, inverses in self.shared:
+            for (key, value), inverse in zip(forcing.simple, inverses):
+                if inverse:
+                    mantissa, exponent = inverse.as_mantissa_exp()
+                    value = weight * (value * domain.from_raw(from_man_exp(int(mantissa), int(exponent))))
+                    terms[key] = terms[key] + value if key in terms else value
+        return Branch(domain, terms)
+
+
 class BranchHierarchy(LazyOrders):
     """Order-by-order solution of a :class:`BranchSystem` (see the module docstring).
 
@@ -228,6 +348,8 @@ class BranchHierarchy(LazyOrders):
         self._pending: dict[int, list[int]] = {}
         self._gap_parts: dict[int, list[Any]] = {}
         self._projection_cache: dict[tuple[int, int], list[Branch]] = {}
+        self._shared_cache: dict[tuple[int, int], list] = {}
+        self._unbuilt: dict[int, Any] = {}  # per order solved (coupled) but not yet formed: its build()
         self._inverse_factorials: list[Any] = [domain.one, domain.one]
 
     # -- read access ---------------------------------------------------------------------------------
@@ -236,6 +358,7 @@ class BranchHierarchy(LazyOrders):
         """W_order: ``branches(order)[piece][component]``."""
         self._ensure(order)
         self._complete(order)
+        self._build(order)
         return self._branches[order]
 
     @locked
@@ -398,6 +521,7 @@ class BranchHierarchy(LazyOrders):
         only the mode component j (A_n and W_{n,j}) — the components k ≠ j and the shifts σ_n are
         solved by :meth:`_complete` when something asks for them (order n + 1, branches, shifts)."""
         self._complete(order - 1)
+        self._build(order - 1)
         system = self.system
         if system.size == 1 or system.arcs != (None, None):
             self._solve_components(order, list(range(system.size)), coupled=True)
@@ -451,15 +575,17 @@ class BranchHierarchy(LazyOrders):
             return _Affine(zero, {index: one})
 
         last_piece = len(system.states) - 1
-        particular: list[list[Branch]] = []
+        ratios = self._ratio_elements
+        particular: list[list[_Particular]] = []
         for piece, state in enumerate(system.states):
             if (piece == 0 and top is not None) or (piece == last_piece and bottom is not None):
-                particular.append([Branch(domain)] * size)  # the stretched arc solves this piece itself
+                particular.append([_Particular(domain, Branch(domain), [])] * size)  # the stretched arc solves it
                 continue
             previous = self._branches[order - system.gauge][piece] if order >= system.gauge else None
             # L W = Σ g (c · W): the projections c · W_{n−1} once per piece (memoised: the components
             # k ≠ j are solved one by one), then one rank-one update per component
             projections = self._projections(order, piece, state, previous) if state.rank_one and previous else []
+            shared = self._shared_forcings(order, piece, state, projections)
             components_rhs = []
             for k in components:
                 rhs: dict = {}  # the right-hand side's terms, each part subtracted in turn (zeros dropped at the end)
@@ -468,6 +594,30 @@ class BranchHierarchy(LazyOrders):
                 for l, entry in enumerate(state.stiffness[k] if state.stiffness and previous else ()):
                     if entry:
                         _subtract(rhs, previous[l], entry)
+                if shared is not None and k != mode:
+                    # a component k ≠ j in a float field: the shared parts (projections, element forces) are
+                    # solved term by term (_SharedForcing); its own right-hand side keeps the rest
+                    if order == system.gauge and state.load[k]:
+                        _subtract(rhs, Branch.constant(domain, state.load[k]))
+                    parts = []
+                    ratio = ratios[k]
+                    close = abs(float(ratio)) * 1e-6
+                    for forcing, part in shared:
+                        if not forcing[k]:
+                            continue
+                        weight = -forcing[k]
+                        near = part.near(float(ratio), close)
+                        for t in near:  # (near) resonance: the general solution
+                            key, value = part.simple[t]
+                            value = weight * value
+                            rhs[key] = rhs[key] + value if key in rhs else value
+                        for key, value in part.others:
+                            value = weight * value
+                            rhs[key] = rhs[key] + value if key in rhs else value
+                        parts.append((weight, part, part.inverses(ratio, near)))
+                    own = Branch(domain, rhs).oscillator_particular_solution(system.ratios[k])
+                    components_rhs.append(_Particular(domain, own, parts))
+                    continue
                 if projections:
                     _subtract(rhs, _combination(domain, projections, [forcing[k] for forcing, _ in state.rank_one]))
                 if order == system.gauge and state.load[k]:
@@ -481,19 +631,15 @@ class BranchHierarchy(LazyOrders):
                             for power, coefficient in powers:
                                 _subtract(rhs, self._law_power(piece, element, power, order - system.gauge),
                                           coefficient * forcing[k])
-                components_rhs.append(Branch(domain, rhs).oscillator_particular_solution(system.ratios[k]))
+                own = Branch(domain, rhs).oscillator_particular_solution(system.ratios[k])
+                components_rhs.append(_Particular(domain, own, []))
             particular.append(components_rhs)
-
-        # the particular solutions' slopes, each formed once per order (they are evaluated at every boundary)
-        particular_slopes = [[branch.derivative() for branch in pieces] for pieces in particular]
-        ratios = self._ratio_elements
 
         def value_of(piece: int, position: int, c: _Affine | None, d: _Affine | None, point: EvaluationPoint,
                      slope: bool) -> _Affine:
             """W_{n,k}^piece (or its slope) at point, for homogeneous parts c, d (k = components[position]; None: zero)."""
             k = components[position]
-            branch = particular_slopes[piece][position] if slope else particular[piece][position]
-            result = _Affine(branch.evaluate(point),
+            result = _Affine(particular[piece][position].value(point, slope),
                              {0: (self._resonant_slope if slope else resonant).evaluate(point)} if k == mode else {})
             if c is None and d is None:
                 return result
@@ -588,20 +734,26 @@ class BranchHierarchy(LazyOrders):
             equations.append(self._first_harmonic_condition(order, particular, c_values, d_values, unit(0), components.index(mode)))
         unknowns = solve_linear([e.dense(unknown_count, zero) for e in equations], [-e.base for e in equations], domain, order)
         branches = [[None] * system.size for _ in system.states] if coupled else self._branches[order]
-        for piece in range(len(system.states)):
-            if (piece == 0 and top is not None) or (piece == last_piece and bottom is not None):
-                branches[piece] = [Branch(domain)] * system.size  # the arc's own representation stands here
-                continue
-            for p, k in enumerate(components):
-                frequency = system.frequency(k)
-                homogeneous = Branch(
-                    domain,
-                    {(frequency, 0, 0): c_values[piece][p].value(unknowns), (frequency, 1, 0): d_values[piece][p].value(unknowns)},
-                )
-                branch = particular[piece][p] + homogeneous
-                if k == mode:
-                    branch = branch + resonant.scale(unknowns[0])
-                branches[piece][k] = branch
+
+        def build() -> None:
+            """W_order's branches: particular solution + homogeneous part (+ the resonant term for j)."""
+            for piece in range(len(system.states)):
+                if (piece == 0 and top is not None) or (piece == last_piece and bottom is not None):
+                    branches[piece] = [Branch(domain)] * system.size  # the arc's own representation stands here
+                    continue
+                for p, k in enumerate(components):
+                    frequency = system.frequency(k)
+                    homogeneous = Branch(domain, {(frequency, 0, 0): c_values[piece][p].value(unknowns),
+                                                  (frequency, 1, 0): d_values[piece][p].value(unknowns)})
+                    branch = particular[piece][p].branch() + homogeneous
+                    if k == mode:
+                        branch = branch + resonant.scale(unknowns[0])
+                    branches[piece][k] = branch
+
+        if coupled:
+            self._unbuilt[order] = build  # formed when a higher order or the branches are asked for
+        else:
+            build()
         if not coupled:
             parts = self._gap_parts[order]
             for index, gap in enumerate(gaps):
@@ -639,6 +791,38 @@ class BranchHierarchy(LazyOrders):
                 self._projection_cache.clear()
             self._projection_cache[key] = [_combination(self._domain, previous, coupling) for _, coupling in state.rank_one]
         return self._projection_cache[key]
+
+    def _shared_forcings(self, order: int, piece: int, state: ContactState,
+                         projections: list[Branch]) -> list[tuple[tuple[Any, ...], _SharedForcing]] | None:
+        """The parts of order ``order``'s right-hand sides on ``piece`` that every component receives with its own
+        weight (``(g, S)``: −g_k S for component k): the rank-one projections and the element forces, formed once per
+        order and piece; None in an exact field (there every component's right-hand side is one branch)."""
+        domain, gauge = self._domain, self.system.gauge
+        if domain.is_Exact or self.system.size == 1 or not hasattr(domain, "from_raw"):
+            return None
+        key = (order, piece)
+        if key not in self._shared_cache:
+            if any(cached != order for cached, _ in self._shared_cache):
+                self._shared_cache.clear()
+            parts = [(forcing, _SharedForcing(domain, projection))
+                     for (forcing, _), projection in zip(state.rank_one, projections)]
+            if order >= gauge:
+                for element, (forcing, _, _) in enumerate(state.analytic):
+                    if any(forcing):
+                        parts.append((forcing, _SharedForcing(domain, self._analytic_force(piece, element, order - gauge))))
+                for element, (forcing, _, powers) in enumerate(state.elements):
+                    if any(forcing):
+                        laws = [self._law_power(piece, element, power, order - gauge) for power, _ in powers]
+                        law = _combination(domain, laws, [coefficient for _, coefficient in powers])
+                        parts.append((forcing, _SharedForcing(domain, law)))
+            self._shared_cache[key] = parts
+        return self._shared_cache[key]
+
+    def _build(self, highest: int) -> None:
+        """Form the branches of the orders up to ``highest`` that were solved without them (an order's matching
+        evaluates its particular solutions at points only; the frequency of the highest order needs no branch)."""
+        for order in sorted(order for order in self._unbuilt if order <= highest):
+            self._unbuilt.pop(order)()
 
     def _arc_height(self, k: int, unit: Any) -> _Affine:
         """The release value h_k (k ≠ j) of a first-piece arc among the order's unknowns."""
@@ -750,7 +934,7 @@ class BranchHierarchy(LazyOrders):
         total = resonant_unit.scale(domain.zero)
         for piece, components in enumerate(particular):
             lower, upper = limits[piece], limits[piece + 1]
-            total = total.shift(components[mode].times_cosine(1).integral(lower, upper))
+            total = total.shift(components[mode].branch().times_cosine(1).integral(lower, upper))
             total = total + resonant_unit.scale(resonant_cos.integral(lower, upper))
             total = total + c_values[piece][mode].scale(cos_cos.integral(lower, upper))
             total = total + d_values[piece][mode].scale(sin_cos.integral(lower, upper))
