@@ -25,9 +25,11 @@ from typing import Any
 
 import sympy
 
+from ._errors import BudgetError
+from ._precision import LOCK
 from .limits import Estimate
 
-__all__ = ["ExpansionFeatures", "expansion_estimate", "expansion_features", "multiple_scales_estimate", "nnm_estimate",
+__all__ = ["ExpansionFeatures", "expansion_check", "expansion_estimate", "expansion_features", "multiple_scales_estimate", "nnm_estimate",
            "shooting_estimate"]
 
 _SWITCHES = (sympy.Max, sympy.Min, sympy.Heaviside, sympy.Abs, sympy.sign)
@@ -196,9 +198,7 @@ def expansion_estimate(problem: Any, order: int, precision: int, numeric: bool) 
     """The :class:`~lindstedt.limits.Estimate` of an expansion request (see the module docstring)."""
     features = expansion_features(problem, order, precision, numeric)
     seconds = math.exp(min(features.log_seconds(), 700.0))
-    scale, power, per_breakpoint, per_digit = _MEMORY
-    memory = max(1.0, scale * seconds**power * max(features.breakpoints, 1) ** per_breakpoint
-                 * (features.digits / 30) ** per_digit)
+    memory = _memory_mb(seconds, features.breakpoints, features.digits)
     advice = _advice(problem, features, precision)
     law = _LAW_TEXT.get(problem.f)
     if law is None:  # printing f costs more than the rest of the estimate: once per f (its parameters symbolic)
@@ -209,6 +209,48 @@ def expansion_estimate(problem: Any, order: int, precision: int, numeric: bool) 
     return Estimate(task=f"expansion of {law} to order {order}", seconds=seconds, memory_mb=memory,
                     drivers=features.drivers(), advice=advice,
                     features=tuple((name, vector[name]) for name in FEATURES_OF_KIND[features.kind]))
+
+
+def _memory_mb(seconds: float, breakpoints: int, digits: int) -> float:
+    scale, power, per_breakpoint, per_digit = _MEMORY
+    return max(1.0, scale * seconds**power * max(breakpoints, 1) ** per_breakpoint * (digits / 30) ** per_digit)
+
+
+#: (f with its parameters symbolic, order, digits) → (seconds, MB): the most a numeric expansion of that non-smooth f
+#: is priced at, whatever its parameters' values (:func:`expansion_check`); bounded
+_NUMERIC_BOUNDS: dict[tuple[Any, int, int], tuple[float, float]] = {}
+
+
+def expansion_check(problem: Any, order: int, precision: int, numeric: bool) -> None:
+    """``expansion_estimate(problem, order, precision, numeric).check()``, without pricing f at its parameters' values
+    when a bound fits the budget.
+
+    With ``numeric`` a non-smooth f is priced as "piecewise-float" or "contact-law" (its values decide which),
+    whose models read the order, the digits and the breakpoints only and grow with the breakpoints; putting numbers
+    into f can merge or remove switches, never add one, so the larger of the two at the breakpoints of f with its
+    parameters symbolic bounds the estimate (made once per f, order and digits; a new value of a parameter needs no
+    substitution into f).  A bound above the budget leaves the decision to the estimate itself.
+    """
+    if numeric and problem.is_non_smooth:
+        key = (problem.f, order, precision)
+        bound = _NUMERIC_BOUNDS.get(key)
+        if bound is None:
+            from .problems.oscillator import DISPLACEMENT
+
+            breakpoints = _breakpoints(problem.f, DISPLACEMENT)
+            seconds = max(math.exp(min(ExpansionFeatures(kind, order, 1, breakpoints, 0, False, precision, False)
+                                       .log_seconds(), 700.0)) for kind in ("piecewise-float", "contact-law"))
+            bound = (seconds, _memory_mb(seconds, breakpoints, precision))
+            with LOCK:
+                if len(_NUMERIC_BOUNDS) >= 256:
+                    _NUMERIC_BOUNDS.clear()
+                _NUMERIC_BOUNDS[key] = bound
+        try:
+            Estimate("numeric expansion", seconds=bound[0], memory_mb=bound[1]).check()
+            return
+        except BudgetError:
+            pass
+    expansion_estimate(problem, order, precision, numeric).check()
 
 
 def _advice(problem: Any, features: ExpansionFeatures, precision: int) -> str:

@@ -22,7 +22,7 @@ from ..engine.branches import BranchHierarchy
 from ..engine.contact import contact_normal_form
 from ..engine.smooth import MAX_ORDER, SmoothHierarchy, normal_form
 from ..compiled.family import forget_families
-from .._cost import expansion_estimate
+from .._cost import expansion_check, expansion_estimate
 from ..limits import Estimate
 
 __all__ = ["CACHE_MAXSIZE", "CacheInfo", "LindstedtPoincare", "cache_info", "clear_cache", "expand", "expansion_cost",
@@ -262,7 +262,8 @@ class LindstedtPoincare:
         Expansion
             Lazy, frozen result; nothing beyond the requested quantities is computed.
         """
-        self.estimate(problem, order).check()
+        validate_order(order)
+        expansion_check(problem, order, self.precision, self.numeric)  # self.estimate(problem, order).check()
         form, hierarchy = self.hierarchy(problem, order)
         if problem.has_initial_velocity:  # the copy (== problem) that knows how far its release series goes
             problem = self._released(problem, order)
