@@ -27,6 +27,8 @@ w_0 − κ_i) carries no contact at order zero; it is reported with validity
 
 from __future__ import annotations
 
+import functools
+import operator
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any, Sequence
@@ -338,11 +340,17 @@ def _intervals(problem: Oscillator) -> list[PolynomialInterval]:
             _SYMBOLIC_INTERVALS[problem.f] = symbolic
         symbolic = _SYMBOLIC_INTERVALS[problem.f]
         intervals = []
-        def put(value: sympy.Expr) -> sympy.Expr:  # value.xreplace(values), read directly for a number or a symbol
+        def put(value: sympy.Expr) -> sympy.Expr:
+            """value.xreplace(values): read directly for a number or a symbol, and for a sum or product of such
+            (the Rational that Add or Mul of numbers evaluates to, from Rational arithmetic)."""
             if value.is_Rational:
                 return value
             if value.is_Symbol:
                 return values.get(value, value)
+            if value.is_Mul or value.is_Add:
+                parts = [part if part.is_Rational else values.get(part) for part in value.args]
+                if all(isinstance(part, sympy.Rational) for part in parts):
+                    return functools.reduce(operator.mul if value.is_Mul else operator.add, parts)
             return value.xreplace(values)
 
         for interval in symbolic or ():
