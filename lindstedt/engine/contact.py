@@ -62,13 +62,21 @@ def _powers_on_the_displacement(domain: Any, law: Sequence[Any]) -> tuple:
 
 @dataclass(frozen=True)
 class ContactBoundary:
-    """A breakpoint crossed by w_0 = cos s at the contact angle β = arccos κ."""
+    """A breakpoint crossed by w_0 = cos s at the contact angle β = arccos κ (``angle``; None: acos κ, built when
+    :attr:`contact_angle` is first read — a float hierarchy never needs the expression)."""
 
     kappa: sympy.Expr
-    contact_angle: sympy.Expr
+    angle: sympy.Expr | None
     point: EvaluationPoint
     kappa_element: Any
     sine_element: Any
+
+    @property
+    def contact_angle(self) -> sympy.Expr:
+        """β = arccos κ as a sympy expression."""
+        if self.angle is None:
+            object.__setattr__(self, "angle", _contact_angle(self.kappa))
+        return self.angle
 
 
 @dataclass(frozen=True)
@@ -151,18 +159,20 @@ class _ConstantField:
             self._register(value)
         self.domain = QQ.frac_field(*[generator for generator, _ in self.generators])
 
-    def contact_point(self, kappa: sympy.Expr, angle: sympy.Expr) -> tuple[Any, Any, Any]:
-        """(β, κ, sin β) as elements for the crossing κ with ``angle`` = acos κ; a rational κ in a float field from
-        mpmath's acos and square root 64 bits beyond the field's precision, rounded once (sympy's evaluation of
-        acos κ and sqrt(1 − κ²), ~0.2 ms, gave the same bits on every one of 1200 random κ measured)."""
+    def contact_point(self, kappa: sympy.Expr) -> tuple[sympy.Expr | None, Any, Any, Any]:
+        """(acos κ, β, κ, sin β): the contact angle's expression (None where it was not needed: a rational κ in a float
+        field) and the elements of the crossing κ; such a κ's from mpmath's acos and square root 64 bits beyond the
+        field's precision, rounded once (sympy's evaluation of acos κ and sqrt(1 − κ²), ~0.2 ms, gave the same bits
+        on every one of 1200 random κ measured)."""
         if not (self.numeric and isinstance(kappa, sympy.Rational)):
-            return self.convert(angle), self.convert(kappa), self.convert(_contact_sine(kappa, self.numeric))
+            angle = _contact_angle(kappa)
+            return angle, self.convert(angle), self.convert(kappa), self.convert(_contact_sine(kappa, self.numeric))
         p, q = int(kappa.p), int(kappa.q)
         working = self.domain.precision + 64
         angle_value = mpf_acos(from_rational(p, q, working, round_nearest), working, round_nearest)
         sine_value = mpf_div(mpf_sqrt(from_int((q - p) * (q + p)), working, round_nearest), from_int(q), working,
                              round_nearest)
-        return self.domain.from_raw(angle_value), self.convert(kappa), self.domain.from_raw(sine_value)
+        return None, self.domain.from_raw(angle_value), self.convert(kappa), self.domain.from_raw(sine_value)
 
     def _register(self, value: sympy.Expr) -> None:
         for atom in sympy.preorder_traversal(value):
@@ -591,8 +601,7 @@ def _assemble(
         boundaries.append(ContactBoundary(kappa, sympy.Integer(0), zero, domain.one, domain.zero))
         moving.append(MovingBoundary(zero, (domain.one,), domain.zero, field.convert(first_shift)))
     for kappa in sorted(crossing_kappas, key=lambda k: -k if k.is_number else 0):
-        angle = _contact_angle(kappa)
-        angle_element, kappa_element, sine_element = field.contact_point(kappa, angle)
+        angle, angle_element, kappa_element, sine_element = field.contact_point(kappa)
         point = EvaluationPoint(domain, angle_element, kappa_element, sine_element)
         boundaries.append(ContactBoundary(kappa, angle, point, kappa_element, sine_element))
         moving.append(MovingBoundary(point, (domain.one,), sine_element))
