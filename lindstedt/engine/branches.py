@@ -192,64 +192,71 @@ class _SharedForcing:
     """A part S of an order's right-hand sides that every component k receives with its own weight, −g_k S: a
     rank-one projection ``c · W`` or an element's force (the laws couple the components only through them).
 
-    A component's particular solution of ``v'' + r_k² v = S`` has, for a term ``a trig(ν s)`` (ν ≠ r_k), the term
-    ``a / (r_k² − ν²) trig(ν s)``: its values and slopes at a point are ``Σ_t u_t / (r_k² − ν_t²)`` over the
-    products ``u_t = a_t trig_t(s0)`` (or ``a_t trig_t'(s0)``), formed once per point for every component — O(|S|)
-    per component and point in gmpy2 at the field's precision (each product and quotient rounded as the field
-    rounds it, the sum correctly rounded), no branch per component.  The other terms (powers of s, ν near r_k) go
-    to the component's own right-hand side.  Float fields only (with ``from_raw``).
+    A component's particular solution of ``v'' + r_k² v = S`` has, for the terms ``a cos(ν s) + b sin(ν s)`` of a
+    harmonic ν ≠ r_k, the terms ``(a cos(ν s) + b sin(ν s)) / (r_k² − ν²)``: its values and slopes at a point are
+    ``Σ_ν u_ν / (r_k² − ν²)`` over ``u_ν = a cos(ν s0) + b sin(ν s0)`` (or their slope), formed once per point for
+    every component — O(|S|) per component and point in gmpy2 at the field's precision (each product and quotient
+    rounded as the field rounds it, the sum correctly rounded), no branch per component.  The other terms (powers
+    of s, ν near r_k) go to the component's own right-hand side.  Float fields only (with ``from_raw``).
     """
 
-    __slots__ = ("domain", "context", "simple", "floats", "squares", "others", "_products")
+    __slots__ = ("domain", "precision", "groups", "floats", "squares", "others", "_products")
 
     def __init__(self, domain: Any, branch: Branch):
         self.domain = domain
-        self.context = gmpy2.context(precision=domain.precision)
-        self.simple = [(key, value) for key, value in branch.terms.items() if not key[2]]
-        self.floats = sorted((float(key[0]), t) for t, (key, _) in enumerate(self.simple))  # (ν_t, t) by ν
-        with gmpy2.local_context(self.context):
-            self.squares = [_to_mpfr(key[0] * key[0]) for key, _ in self.simple]  # ν² rounded as the field rounds it
+        self.precision = domain.precision
+        groups: dict[Any, list[tuple[Any, Any]]] = {}  # per harmonic ν: its power-0 terms (key, coefficient)
+        for key, value in branch.terms.items():
+            if not key[2]:
+                groups.setdefault(key[0], []).append((key, value))
+        self.groups = list(groups.values())
+        self.floats = sorted((float(harmonic), g) for g, harmonic in enumerate(groups))  # (ν, group) by ν
+        with gmpy2.context(precision=self.precision):
+            self.squares = [_to_mpfr(harmonic * harmonic) for harmonic in groups]  # ν² rounded as the field rounds it
         self.others = [(key, value) for key, value in branch.terms.items() if key[2]]
         self._products: dict[tuple[EvaluationPoint, bool], list[Any]] = {}
 
     def near(self, ratio: float, distance: float) -> list[int]:
-        """The indices t with |ν_t − r| ≤ distance (bisection of the sorted harmonics)."""
+        """The groups whose harmonic ν has |ν − r| ≤ distance (bisection of the sorted harmonics)."""
         start = bisect_left(self.floats, (ratio - distance, -1))
         stop = bisect_right(self.floats, (ratio + distance, len(self.floats)))
-        return [t for _, t in self.floats[start:stop]]
+        return [g for _, g in self.floats[start:stop]]
 
     def inverses(self, ratio: Any, near: list[int]) -> list[Any]:
-        """``1/(r² − ν_t²)`` for every simple term (mpfr; zero at the indices ``near``, solved by the component)."""
-        with gmpy2.local_context(self.context):
+        """``1/(r² − ν²)`` for every harmonic (mpfr; zero for the groups ``near``, solved by the component)."""
+        with gmpy2.context(precision=self.precision):
             squared = _to_mpfr(ratio * ratio)
             result = list(map(gmpy2.div, repeat(gmpy2.mpfr(1), len(self.squares)), map(gmpy2.sub, repeat(squared),
                                                                                           self.squares)))
-            for t in near:
-                result[t] = gmpy2.mpfr(0)
+            for g in near:
+                result[g] = gmpy2.mpfr(0)
         return result
 
     def products(self, point: EvaluationPoint, slope: bool) -> list[Any]:
-        """``a_t trig_t(s0)`` (``slope``: ``a_t trig_t'(s0)``) for every simple term (mpfr), remembered per point."""
+        """``u_ν`` = Σ a trig(ν s0) (``slope``: Σ a trig'(ν s0)) for every harmonic (mpfr), remembered per point."""
         key = (point, slope)
         cached = self._products.get(key)
         if cached is None:
             cached = []
-            for (harmonic, parity, _), value in self.simple:
-                if slope:  # (cos ν s)' = −ν sin ν s, (sin ν s)' = ν cos ν s
-                    trig = point.sin_multiple(harmonic) if parity == 0 else point.cos_multiple(harmonic)
-                    factor = domain_constant(self.domain, harmonic) if isinstance(harmonic, int) else harmonic
-                    product = -(value * factor * trig) if parity == 0 else value * factor * trig
-                else:
-                    product = value * (point.cos_multiple(harmonic) if parity == 0 else point.sin_multiple(harmonic))
-                cached.append(product)
-            with gmpy2.local_context(self.context):
+            for group in self.groups:
+                total = None
+                for (harmonic, parity, _), value in group:
+                    if slope:  # (cos ν s)' = −ν sin ν s, (sin ν s)' = ν cos ν s
+                        trig = point.sin_multiple(harmonic) if parity == 0 else point.cos_multiple(harmonic)
+                        factor = domain_constant(self.domain, harmonic) if isinstance(harmonic, int) else harmonic
+                        product = -(value * factor * trig) if parity == 0 else value * factor * trig
+                    else:
+                        product = value * (point.cos_multiple(harmonic) if parity == 0 else point.sin_multiple(harmonic))
+                    total = product if total is None else total + product
+                cached.append(total)
+            with gmpy2.context(precision=self.precision):
                 cached = [_to_mpfr(product) for product in cached]
             self._products[key] = cached
         return cached
 
     def solution_at(self, inverses: list[Any], point: EvaluationPoint, slope: bool) -> Any:
-        """Σ_t u_t/(r² − ν_t²) at ``point`` (a field element) for the inverses of one component."""
-        with gmpy2.local_context(self.context):
+        """Σ_ν u_ν/(r² − ν²) at ``point`` (a field element) for the inverses of one component."""
+        with gmpy2.context(precision=self.precision):
             total = gmpy2.fsum(map(gmpy2.mul, self.products(point, slope), inverses))
         mantissa, exponent = total.as_mantissa_exp()
         return self.domain.from_raw(from_man_exp(int(mantissa), int(exponent)))
@@ -265,7 +272,7 @@ class _Particular:
     def __init__(self, domain: Any, own: Branch, shared: list[tuple[Any, _SharedForcing, list[Any]]]):
         self.domain = domain
         self.own = own  # the particular solution of the component's own right-hand side
-        self.shared = shared  # (−g_k, S, the inverses 1/(r_k² − ν²) of S's simple terms, zero where solved in own)
+        self.shared = shared  # (−g_k, S, the inverses 1/(r_k² − ν²) of S's harmonics, zero where solved in own)
         self._slope: Branch | None = None
 
     def value(self, point: EvaluationPoint, slope: bool) -> Any:
@@ -287,11 +294,13 @@ class _Particular:
         terms = dict(self.own.terms)
         domain = self.domain
         for weight, forcing, inverses in self.shared:
-            for (key, value), inverse in zip(forcing.simple, inverses):
+            for group, inverse in zip(forcing.groups, inverses):
                 if inverse:
                     mantissa, exponent = inverse.as_mantissa_exp()
-                    value = weight * (value * domain.from_raw(from_man_exp(int(mantissa), int(exponent))))
-                    terms[key] = terms[key] + value if key in terms else value
+                    inverse = domain.from_raw(from_man_exp(int(mantissa), int(exponent)))
+                    for key, value in group:
+                        value = weight * (value * inverse)
+                        terms[key] = terms[key] + value if key in terms else value
         return Branch(domain, terms)
 
 
@@ -607,10 +616,10 @@ class BranchHierarchy(LazyOrders):
                             continue
                         weight = -forcing[k]
                         near = part.near(float(ratio), close)
-                        for t in near:  # (near) resonance: the general solution
-                            key, value = part.simple[t]
-                            value = weight * value
-                            rhs[key] = rhs[key] + value if key in rhs else value
+                        for group in near:  # (near) resonance: the general solution
+                            for key, value in part.groups[group]:
+                                value = weight * value
+                                rhs[key] = rhs[key] + value if key in rhs else value
                         for key, value in part.others:
                             value = weight * value
                             rhs[key] = rhs[key] + value if key in rhs else value
