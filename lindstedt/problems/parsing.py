@@ -500,6 +500,11 @@ def _parse_text(text: str, symbols: Mapping[str, sympy.Expr], what: str) -> symp
     if not text.strip():
         raise ProblemError(f"{what} is empty; give an expression such as 'u**3'")
     source = text.strip().replace("^", "**")
+    ratio = _RATIO.fullmatch(source)
+    if ratio is not None:
+        number = _ratio(ratio, what, text)
+        if number is not None:
+            return number
     shape, tree = _SHAPES.get(source), None
     if shape is None:
         try:
@@ -532,6 +537,27 @@ def _parse_text(text: str, symbols: Mapping[str, sympy.Expr], what: str) -> symp
     _PARSED[key] = expression
     _SHAPES[source] = shape
     return expression
+
+
+#: an integer or a quotient of two (most numeric arguments: "1/3", "-2"), as Python's grammar writes them (no leading
+#: zeros); read by :func:`_ratio` without building the syntax tree
+_RATIO = re.compile(r"(-?)(0|[1-9][0-9]*)(?:/(0|[1-9][0-9]*))?")
+
+
+def _ratio(match: re.Match, what: str, text: str) -> sympy.Rational | None:
+    """The number a :data:`_RATIO` text is read as — ``-a/b`` is ``(-a)/b`` — with the bounds the tree's reading
+    applies (nodes, depth, literal length, size of the quotient); None where a bound or a zero divisor is met (the
+    tree's reading then gives its error)."""
+    sign, numerator, denominator = match.groups()
+    nodes = 2 + 2 * bool(sign) + 3 * (denominator is not None)
+    if (denominator == "0" or nodes > LIMITS.nodes or LIMITS.depth < 2
+            or max(len(numerator), len(denominator or "")) > LIMITS.literal):
+        return None
+    number = sympy.Integer(-int(numerator) if sign else int(numerator))
+    if denominator is None:
+        return number
+    number = number / sympy.Integer(int(denominator))
+    return number if _bits(number) <= LIMITS.bits else None
 
 
 def as_exact(value: Any, *, what: str) -> sympy.Expr:
