@@ -30,16 +30,19 @@ class _Affine:
         self.base = base
         self.terms = terms
 
+    # A zero coefficient (a value of a zero function, e.g. s sin s at 0) is dropped where it is met: absent is zero.
     def __add__(self, other: "_Affine") -> "_Affine":
         terms = dict(self.terms)
         for index, value in other.terms.items():
-            terms[index] = terms[index] + value if index in terms else value
+            if value:
+                terms[index] = terms[index] + value if index in terms else value
         return _Affine(_plus(self.base, other.base), terms)
 
     def __sub__(self, other: "_Affine") -> "_Affine":
         terms = dict(self.terms)
         for index, value in other.terms.items():
-            terms[index] = terms[index] - value if index in terms else -value
+            if value:
+                terms[index] = terms[index] - value if index in terms else -value
         base, subtracted = self.base, other.base
         return _Affine((base - subtracted if base else -subtracted) if subtracted else base, terms)
 
@@ -47,15 +50,20 @@ class _Affine:
         if not factor:
             return _Affine(factor, {})
         base = self.base
-        return _Affine(base * factor if base else base, {index: value * factor for index, value in self.terms.items()})
+        return _Affine(base * factor if base else base,
+                       {index: value * factor for index, value in self.terms.items() if value})
 
     def shift(self, constant: Any) -> "_Affine":
         return _Affine(_plus(self.base, constant), dict(self.terms))
 
     def value(self, unknowns: Sequence[Any]) -> Any:
         total = self.base
-        for index in sorted(self.terms):
-            total = total + self.terms[index] * unknowns[index]
+        terms = self.terms
+        for index in sorted(terms):
+            coefficient = terms[index]
+            if coefficient:
+                product = coefficient * unknowns[index]
+                total = total + product if total else product
         return total
 
     def dense(self, count: int, zero: Any) -> list[Any]:
