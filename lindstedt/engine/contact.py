@@ -254,9 +254,15 @@ class _FloatField(RealField):
             value = a._mpf_
             if b is not one:
                 value = mpf_mul(value, b._mpf_, prec, rounding)
-            if c is not one:
+                if c is not one:
+                    value = mpf_mul(value, c._mpf_, prec, rounding)
+            elif c is not one:
                 value = mpf_mul(value, c._mpf_, prec, rounding)
-            total = mpf_add(total, value, prec, rounding)
+            else:
+                total = mpf_add(total, value, prec, rounding)
+                continue
+            # a product is rounded to the field's precision already: 0 + it is itself (mpf_add would normalize it)
+            total = value if total is fzero else mpf_add(total, value, prec, rounding)
         return self._context.make_mpf(total)
 
     def to_sympy(self, element: Any) -> sympy.Float:
