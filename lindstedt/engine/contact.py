@@ -237,6 +237,19 @@ def _contact_sine(kappa: sympy.Expr, numeric: bool = False) -> sympy.Expr:
     return sympy.sqrt(1 - kappa**2)
 
 
+def _turning_points(field: "_ConstantField") -> tuple[EvaluationPoint, EvaluationPoint]:
+    """The points s = 0 and s = π; a float field's are made once and shared (the cosines, sines and powers they
+    remember do not depend on the problem)."""
+    domain = field.domain
+    points = domain.__dict__.get("_turning_points") if isinstance(domain, _FloatField) else None
+    if points is None:
+        points = (EvaluationPoint(domain, domain.zero, domain.one, domain.zero),
+                  EvaluationPoint(domain, field.convert(sympy.pi), -domain.one, domain.zero))
+        if isinstance(domain, _FloatField):
+            domain.__dict__["_turning_points"] = points  # a race makes a second pair: harmless
+    return points
+
+
 class _FloatField(RealField):
     """``RealField`` with the fused ``sum_of_products`` of :func:`~lindstedt.algebra.contact_field.sum_of_products`:
     Σ a·b·c added in order on mpmath's raw values, each product and sum rounded to the field's precision as the
@@ -600,8 +613,7 @@ def _assemble(
     domain = field.domain
     piece_laws = [tuple(field.convert(value) for value in w_intervals[interval_index][2]) for interval_index in interval_of]
     arcs = _stretched_arcs(problem, w_intervals, interval_of, fractional_pieces, crossing_kappas, grazing, field) if fractional_pieces else (None, None)
-    zero = EvaluationPoint(domain, domain.zero, domain.one, domain.zero)
-    pi_point = EvaluationPoint(domain, field.convert(sympy.pi), -domain.one, domain.zero)
+    zero, pi_point = _turning_points(field)
     boundaries, moving = [], []
     for kappa, _, first_shift in top:
         boundaries.append(ContactBoundary(kappa, sympy.Integer(0), zero, domain.one, domain.zero))
