@@ -48,16 +48,21 @@ conditions are the value and slope match at s_L* and ``A_n = [μ (π − s_L*)²
 
 Coefficients live in any sympy field: exact (``QQ``, ``QQ(π, κ, β, …)``) or a
 ``RealField`` of the working precision (always, with a stretched arc).
+
+In an N-dof float field the laws reach the components only through shared parts of the right-hand side — the
+rank-one projections ``c · W`` and the element forces, each O(N) terms: a component k ≠ j receives them with its
+weight −g_k, and their particular solutions ``Σ_ν u_ν/(r_k² − ν²)`` are evaluated at the few points the matching
+needs (:class:`_SharedForcing`), not formed as one O(N)-term branch per component; an order solved with every
+component coupled (a stretched arc) forms its branches only when a higher order or a waveform asks for them.
 """
 
 from __future__ import annotations
 
 import math
 from bisect import bisect_left, bisect_right
-from itertools import repeat
 from dataclasses import dataclass
+from itertools import repeat
 from typing import Any, Sequence
-
 
 import gmpy2
 from mpmath.libmp import from_man_exp
