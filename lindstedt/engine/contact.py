@@ -216,6 +216,9 @@ def _sign_of_amplitude(amplitude: sympy.Expr) -> int:
 
 def _compare(value: sympy.Expr, bound: int) -> int | None:
     """Sign of value - bound when decidable, else None."""
+    if isinstance(value, sympy.Rational):  # p/q − bound has the sign of p − bound·q (q > 0)
+        difference = int(value.p) - bound * int(value.q)
+        return (difference > 0) - (difference < 0)
     difference = value - bound
     if difference.is_Rational:  # decided: no simplification to try
         return (difference.p > 0) - (difference.p < 0)
@@ -332,7 +335,7 @@ def _guard_digits(kappas: list[sympy.Expr], order: int) -> int:
     (2k + 3)·log10(1/m) digits cancel; they are added to the working precision.
     """
     # |κ| ≤ 1/2 keeps the margin above π/3 > 1, which adds nothing: decided without evaluating acos κ
-    kappas = [kappa for kappa in kappas if kappa.is_number and not (kappa.is_Rational and abs(kappa) <= _HALF)]
+    kappas = [kappa for kappa in kappas if kappa.is_number and not (kappa.is_Rational and 2 * abs(int(kappa.p)) <= kappa.q)]
     if not kappas:
         return 0
     margin = mpmath.mpf(1)
