@@ -10,6 +10,7 @@ from __future__ import annotations
 from typing import Any, Sequence
 
 import mpmath
+from mpmath.libmp import fzero, mpf_abs, mpf_cmp, mpf_mul
 
 from .._errors import ResonanceError
 
@@ -96,19 +97,30 @@ def solve_linear(matrix: list[list[Any]], vector: list[Any], domain: Any, order:
     exact = domain.is_Exact
     threshold = None
     if not exact:
-        scale = max((abs(entry) for row in matrix for entry in row), default=domain.one) or domain.one
+        # magnitudes compared on mpmath's raw values (the decisions max() and > take on the elements)
+        scale = fzero
+        for row in matrix:
+            for entry in row:
+                magnitude = mpf_abs(entry._mpf_)
+                if mpf_cmp(magnitude, scale) > 0:
+                    scale = magnitude
         relative = _THRESHOLDS.get(domain.dps)
         if relative is None:
             if len(_THRESHOLDS) >= 256:
                 _THRESHOLDS.clear()
             relative = _THRESHOLDS[domain.dps] = mpmath.mpf(10) ** (-(domain.dps - 3))
-        threshold = scale * relative
+        prec, rounding = domain.one.context._prec_rounding
+        threshold = mpf_mul(scale if scale != fzero else domain.one._mpf_, relative._mpf_, prec, rounding)
     for column in range(size):
         if exact:
             pivot = next((r for r in range(column, size) if rows[r][column]), None)
         else:
-            pivot = max(range(column, size), key=lambda r: abs(rows[r][column]))
-            pivot = pivot if abs(rows[pivot][column]) > threshold else None
+            pivot, largest = column, mpf_abs(rows[column][column]._mpf_)
+            for r in range(column + 1, size):
+                magnitude = mpf_abs(rows[r][column]._mpf_)
+                if mpf_cmp(magnitude, largest) > 0:
+                    pivot, largest = r, magnitude
+            pivot = pivot if mpf_cmp(largest, threshold) > 0 else None
         if pivot is None:
             raise ResonanceError(f"the order-{order} matching system is singular (internal resonance or tangent contact)")
         rows[column], rows[pivot] = rows[pivot], rows[column]
