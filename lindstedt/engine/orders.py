@@ -56,15 +56,18 @@ def shift_powers(shifts: list[Any], order: int, domain: Any, previous: tuple[int
     """
     zero, one = domain.zero, domain.one
     padded = [zero] + [shifts[i] if i < len(shifts) else zero for i in range(1, order + 1)]
+    shifted = [i for i in range(1, order + 1) if padded[i]]  # the σ_i ≠ 0: a zero factor adds nothing to a sum
     known = min(len(shifts), order + 1)
     powers = [[one] + [zero] * order]
     for power in range(1, order + 1):
         last = powers[-1]
+        nonzero = [bool(value) for value in last]
         row: list[Any] = []
         if previous is not None and power < len(previous[1]):
             earlier = previous[1][power]
             row = earlier[:max(0, min(order, len(earlier) - 1, min(previous[0], known) + power - 2) + 1)]
-        row += [sum_of_products(domain, [(last[j - i], padded[i], one) for i in range(1, j + 1)]) for j in range(len(row), order + 1)]
+        row += [sum_of_products(domain, [(last[j - i], padded[i], one) for i in shifted if i <= j and nonzero[j - i]])
+                for j in range(len(row), order + 1)]
         powers.append(row)
     return powers
 
