@@ -263,15 +263,16 @@ def _advice(problem: Any, features: ExpansionFeatures, precision: int) -> str:
     return "ask for a lower order"
 
 
-#: The NNM expansion of an N-dof system with S springs: T = _NNM[0] · N^1.25 (S/3)^0.2 + [order ≥ 3] _NNM[1] · N^1.6 ·
+#: The NNM expansion of an N-dof system with S springs: T = _NNM[0] · N^1.25 (S/3)^0.2 + [order ≥ 3] _NNM[1] · N^1.3 ·
 #: 2.5^(order − 3) (S/3)^1.084 CPU seconds.  Recalibrated on the benchmark chain (3 springs) after the issue-26
 #: modal refinement (packed columns, banded corrections): order ≤ 2 is the modal coupling, 0.28 / 0.30 s at N = 200
 #: (orders 1, 2), 0.60 s at 500, 1.40 s at 1000, ~4.5 s at 2000; from order 3 the hierarchy's combination tones
-#: dominate, 0.6 / 1.55 / 5.5 s at N = 50 / 100 / 200 (order 3) and ×2.5 an order (N = 50: 1.51 s at order 4,
-#: 3.83 s at 5).  The coupling hardly depends on S (1000 dof, order 2: 1.28 s with one spring, 1.40 s with three;
+#: dominate: after the shared right-hand sides of the order solve (issue 26) 0.49 / 0.79 / 2.09 s CPU at
+#: N = 50 / 100 / 200 (order 3; it was 0.6 / 1.55 / 5.5 s, N^1.6) and ×2.2–2.5 an order (N = 50: 1.22 s at order 4,
+#: 2.65 s at 5); estimate/measured 0.9–1.4.  The coupling hardly depends on S (1000 dof, order 2: 1.28 s with one spring, 1.40 s with three;
 #: 200 dof: 0.21 / 0.30 / 0.35 s with 1 / 3 / 6); the tones' springs exponent is the earlier fit's.  The constants carry
 #: 1.2–1.5× of margin.
-_NNM = (3.4e-4, 1.2e-3)
+_NNM = (3.4e-4, 1.9e-3)
 #: Its memory: the float modal matrices (``_NNM_MEMORY[0] · N²`` MB: the modes, their gaps and projections; the
 #: fixed-point shapes are refined a block at a time — chain of 1000 dof 59–65 MB, 2000 dof 106 MB measured over the
 #: import baseline, so the N² term keeps a margin of 1.5–4×) or the hierarchy
@@ -279,28 +280,31 @@ _NNM = (3.4e-4, 1.2e-3)
 _NNM_MEMORY = (1e-4, 12.0)
 
 
-#: Elements of other laws (measured on chains with a gap spring and one element, a0 = 3, this machine):
-#: a Hertz contact arc costs ``_NNM_ARC · N · (order + 1)`` s (Chebyshev integrals at 128 nodes per component and
-#: order, the transforms in fixed point; a Hertz element between two masses of a unit chain, a0 = 1: 0.39 s at N = 5,
-#: order 1; 0.74 s at N = 20, order 1; 1.43 s at N = 40, order 1; 8.2 s at N = 40, order 2 — the former 0.12 was
-#: measured before the fixed-point transforms and overestimated 4–7×); products of branches (powers ≥ 2, analytic laws)
-#: cost ``_NNM_PRODUCTS · N^1.6 · 9^(order − 2)`` s from order 3 on (combination tones of the N modal frequencies:
-#: sin(u) with a crossing, 1.28 s at N = 5, order 3; 11.9 s at N = 5, order 4; 12.1 s at N = 20, order 3); order 2
-#: stays linear in N (0.77 s for a cubic spring at N = 200).  An analytic contact arc without a fractional power
-#: costs the same per dof and order (``Max(0, u - 1/5)*exp(u)`` on the middle mass of a chain with a gap spring,
-#: a0 = 3: 0.13 s at N = 5, order 1; 1.7 s at N = 20, order 2; 6.4 s at N = 40, order 3).
-_NNM_ARC, _NNM_PRODUCTS = 0.03, 0.015
+#: Elements of other laws.  A stretched contact arc (a law with a fractional power, or an analytic part next to a
+#: breakpoint) carries every modal component on one Chebyshev grid that resolves cos(β r_k τ) of the stiffest,
+#: r_max = λ_N/λ_mode, in the variable (1 − τ)^(1/d) (d the exponent's denominator, 2 for Hertz; 1 for an analytic
+#: law): ``(_NNM_ARC[0] + _NNM_ARC[1] · N · r_max · d) · (order + 1)/3`` s.  Measured (issue 26, after the mpfr node
+#: arithmetic and the shared right-hand sides; the benchmark chain with a Hertz gap 1/100 and a cubic spring, mode 1,
+#: order 2, wall): all modes N = 20 / 40 / 80 / 160 (r_max 13 / 26 / 52 / 102): 0.44 / 1.1 / 1.7 / 7.0 s, order 1 at
+#: N = 20 0.23 s; through ResidualFlexibility(8) (13 components, r_max 93 / 453 / 903 at 200 / 1000 / 2000 dof):
+#: 0.80 / 0.89 / 1.86 s.  Estimate/measured 0.6–1.2 with all modes, 0.9–2.9 reduced (a small contact angle β
+#: there needs fewer nodes than r_max says; β is known only once the orbit is).  Products of branches (powers ≥ 2,
+#: analytic laws) cost ``_NNM_PRODUCTS · N² · 9^(order − 2)`` s from order 3 on (combination tones of the N modal
+#: frequencies; the benchmark chain, Hertz + cubic, order 3: 2.6 / 11.2 / 45.9 s at N = 20 / 40 / 80, N^2.0; a
+#: sin(u) element on a 5-dof chain 0.44 s at order 3, 2.24 s at order 4: estimate/measured 0.8–2); order 2 stays
+#: linear in N.
+_NNM_ARC, _NNM_PRODUCTS = (0.3, 2e-4), 1.5e-3
 
 
-def _law_costs(system: Any) -> tuple[float, bool]:
-    """(the seconds per dof and order of a stretched contact arc — a law with a fractional power, or an analytic part
-    next to a breakpoint; 0 without one — and whether a law multiplies branches — a piece of degree ≥ 2 or an
-    analytic law without breakpoints), read from the laws' pieces."""
+def _law_costs(system: Any) -> tuple[int, bool]:
+    """(the largest denominator d of a stretched contact arc's exponents — a law with a fractional power; 1 for an
+    analytic part next to a breakpoint; 0 without an arc — and whether a law multiplies branches — a piece of
+    degree ≥ 2 or an analytic law without breakpoints), read from the laws' pieces."""
     from ._errors import LindstedtError
     from .problems.piecewise_linear import decompose_piecewise
     from .problems.system import LAW_VARIABLE, UNILATERAL
 
-    arc, products = 0.0, False
+    arc, products = 0, False
     for law in set(getattr(system, "laws", ())):
         if law == UNILATERAL:
             continue
@@ -308,9 +312,11 @@ def _law_costs(system: Any) -> tuple[float, bool]:
             intervals = decompose_piecewise(law, LAW_VARIABLE)
         except LindstedtError:  # refused by the method itself, with its own words
             continue
-        if any(interval.fractional for interval in intervals) or (
-                len(intervals) > 1 and any(interval.analytic != 0 for interval in intervals)):
-            arc = _NNM_ARC
+        for interval in intervals:
+            for _, _, exponent in interval.fractional:
+                arc = max(arc, int(sympy.Rational(exponent).q))
+        if len(intervals) > 1 and any(interval.analytic != 0 for interval in intervals):
+            arc = max(arc, 1)
         # an analytic part next to a breakpoint multiplies on its arc (priced above), one without breakpoints branches
         products = products or any(len(interval.coefficients) > 2 for interval in intervals) or \
             (len(intervals) == 1 and intervals[0].analytic != 0)
@@ -321,12 +327,15 @@ def nnm_estimate(system: Any, mode: int, order: int) -> Estimate:
     """The :class:`~lindstedt.limits.Estimate` of the strained-coordinates NNM of ``system`` to ``order``."""
     n, springs = system.n_dof, max(len(system.b), 1)
     coupling, tones = _NNM
-    seconds = coupling * n**1.25 * (springs / 3) ** 0.2 + (tones * n**1.6 * 2.5 ** (order - 3) * (springs / 3) ** 1.084
+    seconds = coupling * n**1.25 * (springs / 3) ** 0.2 + (tones * n**1.3 * 2.5 ** (order - 3) * (springs / 3) ** 1.084
                                                            if order >= 3 else 0.0)
-    arc, products = _law_costs(system)
-    seconds += arc * n * (order + 1)
+    denominator, products = _law_costs(system)
+    if denominator:  # the float modes: cached on the system, the expansion reads them too
+        frequencies = system.modes()[0]
+        stiffest = float(frequencies[-1] / frequencies[mode - 1]) * denominator
+        seconds += (_NNM_ARC[0] + _NNM_ARC[1] * n * stiffest) * (order + 1) / 3
     if products and order >= 3:
-        seconds += _NNM_PRODUCTS * n**1.6 * 9.0 ** (order - 2)
+        seconds += _NNM_PRODUCTS * n**2 * 9.0 ** (order - 2)
     memory = max(1.0, _NNM_MEMORY[0] * n * n, _NNM_MEMORY[1] * seconds**0.9)
     return Estimate(task=f"NNM expansion of mode {mode} of a {n}-dof system to order {order}", seconds=seconds,
                     memory_mb=memory, drivers=(("degrees of freedom", n), ("springs", springs), ("order", order)),
