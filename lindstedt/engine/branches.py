@@ -52,261 +52,26 @@ Coefficients live in any sympy field: exact (``QQ``, ``QQ(π, κ, β, …)``) or
 In an N-dof float field the laws reach the components only through shared parts of the right-hand side — the
 rank-one projections ``c · W`` and the element forces, each O(N) terms: a component k ≠ j receives them with its
 weight −g_k, and their particular solutions ``Σ_ν u_ν/(r_k² − ν²)`` are evaluated at the few points the matching
-needs (:class:`_SharedForcing`), not formed as one O(N)-term branch per component; an order solved with every
+needs (:class:`~lindstedt.engine.particular.SharedForcing`), not formed as one O(N)-term branch per component; an order solved with every
 component coupled (a stretched arc) forms its branches only when a higher order or a waveform asks for them.
 """
 
 from __future__ import annotations
 
 import math
-from bisect import bisect_left, bisect_right
-from dataclasses import dataclass
-from itertools import repeat
-from typing import Any, Sequence
+from typing import Any
 
-import gmpy2
-from mpmath.libmp import from_man_exp
 from sympy import QQ
 
 from ..algebra.branch import Branch, EvaluationPoint, domain_constant
 from .._precision import locked
 from .orders import LazyOrders, shift_powers, sum_of_products
 from .affine import _Affine, solve_linear
+from .branch_system import BranchSystem, ContactState, MovingBoundary
 from .float_branches import FloatBranches
-from .stretched import VectorArc
+from .particular import Particular, SharedForcing, combination, subtract_into
 
-__all__ = ["BranchHierarchy", "BranchSystem", "ContactState", "MovingBoundary"]
-
-
-@dataclass(frozen=True)
-class ContactState:
-    """One contact state: the law ε̂ (L W + m + Σ_e g_e Σ_m c_{e,m} (c_e · W)^m) on a piece of [0, π] (rows of
-    domain elements).
-
-    ``rank_one`` lists pairs ``(g, c)`` adding ``g cᵀ`` to L (``stiffness`` holds the dense
-    rest, or is empty): the N-dof normal form's ``L_p = Σ_{i active} G_i B_iᵀ``, applied as
-    one projection ``c · W`` and one rank-one update per pair, O(N) instead of O(N²).
-    ``elements`` lists ``(g, c, ((m, c_m), …))``, m ≥ 2: the higher powers of a polynomial law acting on
-    the deformation ``c · W`` with the force direction g — the 1-dof oscillator's piecewise-polynomial f is
-    ``((1,), (1,), …)``, an N-dof element's ``(G_i, B_i, …)``.
-    ``analytic`` lists ``(g, c, law)``: an analytic law of the deformation ``y = c · W`` expanded about its
-    order-zero value, ``Σ_m law.branch(m) [(y − y_0)^m]_n`` (``law.branch(m)``: the cosine series of its m-th Taylor
-    coefficient along ``y_0(s)``).
-    """
-
-    stiffness: tuple[tuple[Any, ...], ...]
-    load: tuple[Any, ...]
-    elements: tuple[tuple[tuple[Any, ...], tuple[Any, ...], tuple[tuple[int, Any], ...]], ...] = ()
-    rank_one: tuple[tuple[tuple[Any, ...], tuple[Any, ...]], ...] = ()
-    analytic: tuple[tuple[tuple[Any, ...], tuple[Any, ...], Any], ...] = ()
-
-
-@dataclass(frozen=True)
-class MovingBoundary:
-    """A contact angle β = arccos κ where ``Σ_k coupling[k] W_k`` crosses κ.
-
-    A simple crossing has ``sine`` = sin β ≠ 0 and moves as ``s* = β + Σ σ_n η^n``.  A
-    *grazing* boundary sits at a turning point (β = 0 or π, sine 0): the gap has a double
-    root there, the crossing exists only because the order-one orbit moves past the
-    breakpoint, and its shift starts at ``first_shift`` = σ_1 in the gauge η = ε̂^{1/2}
-    (root of the quadratic contact condition, chosen by the normal form).
-    """
-
-    point: EvaluationPoint
-    coupling: tuple[Any, ...]
-    sine: Any
-    first_shift: Any = None
-
-    @property
-    def grazing(self) -> bool:
-        """True for a boundary at a turning point (double root of the order-zero gap)."""
-        return self.first_shift is not None
-
-
-@dataclass(frozen=True)
-class BranchSystem:
-    """The normalised piecewise-linear problem that :class:`BranchHierarchy` solves (module docstring).
-
-    ``ratios[k] = r_k`` (``None`` for the mode component j, whose frequency is 1
-    and whose solves use the exact rational kernel); ``states`` has one entry per
-    piece of [0, π], ``boundaries`` one per crossing, increasing in angle;
-    ``release`` is ``(w_1, w_2, …)``, the ε̂-coefficients of W_j(0) under the "initial" normalisation
-    (shorter tuples mean zeros beyond).
-    ``gauge`` is 1 for expansions in η = ε̂ and 2 for η = ε̂^{1/2} (a grazing boundary is
-    crossed): the laws and the release then enter at order 2 in η.
-    """
-
-    domain: Any
-    ratios: tuple[Any, ...]
-    mode: int
-    states: tuple[ContactState, ...]
-    boundaries: tuple[MovingBoundary, ...]
-    zero_point: EvaluationPoint
-    pi_point: EvaluationPoint
-    release: tuple[Any, ...]
-    gauge: int = 1
-    arcs: tuple[VectorArc | None, VectorArc | None] = (None, None)  # the arcs solving the first / last piece
-
-    def release_at(self, order: int) -> Any | None:
-        """The prescribed W_{order,j}(0) in the gauge's powers (None: zero)."""
-        step, remainder = divmod(order, self.gauge)
-        return self.release[step - 1] if not remainder and 1 <= step <= len(self.release) and self.release[step - 1] else None
-
-    @property
-    def size(self) -> int:
-        """Number of components N."""
-        return len(self.ratios)
-
-    def frequency(self, component: int) -> Any:
-        """r_k as a branch frequency (the integer 1 for the mode component)."""
-        ratio = self.ratios[component]
-        return 1 if ratio is None else ratio
-
-
-def _combination(domain: Any, branches: Sequence[Branch], weights: Sequence[Any]) -> Branch:
-    """Σ_l weights[l] · branches[l], accumulated in one dictionary (a chain of Branch sums would copy O(N²) terms)."""
-    terms: dict = {}
-    for branch, weight in zip(branches, weights):
-        if weight:
-            for key, value in branch.terms.items():
-                terms[key] = terms[key] + value * weight if key in terms else value * weight
-    return Branch(domain, terms)
-
-
-def _subtract(terms: dict, branch: Branch, factor: Any = None) -> None:
-    """terms −= factor · branch in place (the terms ``rhs - branch.scale(factor)`` holds, zeros kept: 0 + x is x)."""
-    if factor is None:
-        for key, value in branch.terms.items():
-            terms[key] = terms[key] + -value if key in terms else -value
-    elif factor:
-        for key, value in branch.terms.items():
-            value = -(value * factor)
-            terms[key] = terms[key] + value if key in terms else value
-
-
-def _to_mpfr(value: Any) -> Any:
-    """A float field's element (or an int) as a gmpy2 mpfr, exactly (in a gmpy2 context of the field's precision)."""
-    if isinstance(value, int):
-        return gmpy2.mpfr(value)
-    sign, mantissa, exponent, _ = value._mpf_
-    result = gmpy2.mul_2exp(gmpy2.mpfr(mantissa), exponent)
-    return -result if sign else result
-
-
-class _SharedForcing:
-    """A part S of an order's right-hand sides that every component k receives with its own weight, −g_k S: a
-    rank-one projection ``c · W`` or an element's force (the laws couple the components only through them).
-
-    A component's particular solution of ``v'' + r_k² v = S`` has, for the terms ``a cos(ν s) + b sin(ν s)`` of a
-    harmonic ν ≠ r_k, the terms ``(a cos(ν s) + b sin(ν s)) / (r_k² − ν²)``: its values and slopes at a point are
-    ``Σ_ν u_ν / (r_k² − ν²)`` over ``u_ν = a cos(ν s0) + b sin(ν s0)`` (or their slope), formed once per point for
-    every component — O(|S|) per component and point in gmpy2 at the field's precision (each product and quotient
-    rounded as the field rounds it, the sum correctly rounded), no branch per component.  The other terms (powers
-    of s, ν near r_k) go to the component's own right-hand side.  Float fields only (with ``from_raw``).
-    """
-
-    __slots__ = ("domain", "precision", "groups", "floats", "squares", "others", "_products")
-
-    def __init__(self, domain: Any, branch: Branch):
-        self.domain = domain
-        self.precision = domain.precision
-        groups: dict[Any, list[tuple[Any, Any]]] = {}  # per harmonic ν: its power-0 terms (key, coefficient)
-        for key, value in branch.terms.items():
-            if not key[2]:
-                groups.setdefault(key[0], []).append((key, value))
-        self.groups = list(groups.values())
-        self.floats = sorted((float(harmonic), g) for g, harmonic in enumerate(groups))  # (ν, group) by ν
-        with gmpy2.context(precision=self.precision):
-            self.squares = [_to_mpfr(harmonic * harmonic) for harmonic in groups]  # ν² rounded as the field rounds it
-        self.others = [(key, value) for key, value in branch.terms.items() if key[2]]
-        self._products: dict[tuple[EvaluationPoint, bool], list[Any]] = {}
-
-    def near(self, ratio: float, distance: float) -> list[int]:
-        """The groups whose harmonic ν has |ν − r| ≤ distance (bisection of the sorted harmonics)."""
-        start = bisect_left(self.floats, (ratio - distance, -1))
-        stop = bisect_right(self.floats, (ratio + distance, len(self.floats)))
-        return [g for _, g in self.floats[start:stop]]
-
-    def inverses(self, ratio: Any, near: list[int]) -> list[Any]:
-        """``1/(r² − ν²)`` for every harmonic (mpfr; zero for the groups ``near``, solved by the component)."""
-        with gmpy2.context(precision=self.precision):
-            squared = _to_mpfr(ratio * ratio)
-            result = list(map(gmpy2.div, repeat(gmpy2.mpfr(1), len(self.squares)), map(gmpy2.sub, repeat(squared),
-                                                                                          self.squares)))
-            for g in near:
-                result[g] = gmpy2.mpfr(0)
-        return result
-
-    def products(self, point: EvaluationPoint, slope: bool) -> list[Any]:
-        """``u_ν`` = Σ a trig(ν s0) (``slope``: Σ a trig'(ν s0)) for every harmonic (mpfr), remembered per point."""
-        key = (point, slope)
-        cached = self._products.get(key)
-        if cached is None:
-            cached = []
-            for group in self.groups:
-                total = None
-                for (harmonic, parity, _), value in group:
-                    if slope:  # (cos ν s)' = −ν sin ν s, (sin ν s)' = ν cos ν s
-                        trig = point.sin_multiple(harmonic) if parity == 0 else point.cos_multiple(harmonic)
-                        factor = domain_constant(self.domain, harmonic) if isinstance(harmonic, int) else harmonic
-                        product = -(value * factor * trig) if parity == 0 else value * factor * trig
-                    else:
-                        product = value * (point.cos_multiple(harmonic) if parity == 0 else point.sin_multiple(harmonic))
-                    total = product if total is None else total + product
-                cached.append(total)
-            with gmpy2.context(precision=self.precision):
-                cached = [_to_mpfr(product) for product in cached]
-            self._products[key] = cached
-        return cached
-
-    def solution_at(self, inverses: list[Any], point: EvaluationPoint, slope: bool) -> Any:
-        """Σ_ν u_ν/(r² − ν²) at ``point`` (a field element) for the inverses of one component."""
-        with gmpy2.context(precision=self.precision):
-            total = gmpy2.fsum(map(gmpy2.mul, self.products(point, slope), inverses))
-        mantissa, exponent = total.as_mantissa_exp()
-        return self.domain.from_raw(from_man_exp(int(mantissa), int(exponent)))
-
-
-class _Particular:
-    """A particular solution of ``v'' + r_k² v = own − Σ_S g_k S`` for one component k on one piece (the shared parts
-    S as :class:`_SharedForcing`): its values and slopes at points for the order's matching, and its branch, formed
-    only when the order's branches are asked for (the frequency needs none of the highest order's)."""
-
-    __slots__ = ("domain", "own", "shared", "_slope")
-
-    def __init__(self, domain: Any, own: Branch, shared: list[tuple[Any, _SharedForcing, list[Any]]]):
-        self.domain = domain
-        self.own = own  # the particular solution of the component's own right-hand side
-        self.shared = shared  # (−g_k, S, the inverses 1/(r_k² − ν²) of S's harmonics, zero where solved in own)
-        self._slope: Branch | None = None
-
-    def value(self, point: EvaluationPoint, slope: bool) -> Any:
-        """The particular solution (``slope``: its derivative) at ``point``."""
-        if slope:
-            if self._slope is None:
-                self._slope = self.own.derivative()
-            total = self._slope.evaluate(point)
-        else:
-            total = self.own.evaluate(point)
-        for weight, forcing, inverses in self.shared:
-            total = total + weight * forcing.solution_at(inverses, point, slope)
-        return total
-
-    def branch(self) -> Branch:
-        """The particular solution as a branch."""
-        if not self.shared:
-            return self.own
-        terms = dict(self.own.terms)
-        domain = self.domain
-        for weight, forcing, inverses in self.shared:
-            for group, inverse in zip(forcing.groups, inverses):
-                if inverse:
-                    mantissa, exponent = inverse.as_mantissa_exp()
-                    inverse = domain.from_raw(from_man_exp(int(mantissa), int(exponent)))
-                    for key, value in group:
-                        value = weight * (value * inverse)
-                        terms[key] = terms[key] + value if key in terms else value
-        return Branch(domain, terms)
+__all__ = ["BranchHierarchy"]
 
 
 class BranchHierarchy(LazyOrders):
@@ -429,7 +194,7 @@ class BranchHierarchy(LazyOrders):
                 if len(nonzero) == 1 and coupling[nonzero[0]] == self._domain.one:
                     result = branches[nonzero[0]]
                 else:
-                    result = _combination(self._domain, [branches[k] for k in nonzero], [coupling[k] for k in nonzero])
+                    result = combination(self._domain, [branches[k] for k in nonzero], [coupling[k] for k in nonzero])
             else:
                 result = Branch(self._domain)
                 for i in range(order + 1):
@@ -464,7 +229,7 @@ class BranchHierarchy(LazyOrders):
                 coupling = self.system.states[piece].analytic[element][1]
                 nonzero = [k for k, weight in enumerate(coupling) if weight]
                 branches = self._branches[order][piece]
-                result = _combination(domain, [branches[k] for k in nonzero], [coupling[k] for k in nonzero])
+                result = combination(domain, [branches[k] for k in nonzero], [coupling[k] for k in nonzero])
             else:
                 result = Branch(domain)
                 for i in range(1, order - power + 2):
@@ -590,10 +355,10 @@ class BranchHierarchy(LazyOrders):
 
         last_piece = len(system.states) - 1
         ratios = self._ratio_elements
-        particular: list[list[_Particular]] = []
+        particular: list[list[Particular]] = []
         for piece, state in enumerate(system.states):
             if (piece == 0 and top is not None) or (piece == last_piece and bottom is not None):
-                particular.append([_Particular(domain, Branch(domain), [])] * size)  # the stretched arc solves it
+                particular.append([Particular(domain, Branch(domain), [])] * size)  # the stretched arc solves it
                 continue
             previous = self._branches[order - system.gauge][piece] if order >= system.gauge else None
             # L W = Σ g (c · W): the projections c · W_{n−1} once per piece (memoised: the components
@@ -604,15 +369,15 @@ class BranchHierarchy(LazyOrders):
             for k in components:
                 rhs: dict = {}  # the right-hand side's terms, each part subtracted in turn (zeros dropped at the end)
                 for i in range(1, order):
-                    _subtract(rhs, self._derivative(order - i, piece, k, 2), self._squared[i])
+                    subtract_into(rhs, self._derivative(order - i, piece, k, 2), self._squared[i])
                 for l, entry in enumerate(state.stiffness[k] if state.stiffness and previous else ()):
                     if entry:
-                        _subtract(rhs, previous[l], entry)
+                        subtract_into(rhs, previous[l], entry)
                 if shared is not None and k != mode:
                     # a component k ≠ j in a float field: the shared parts (projections, element forces) are
-                    # solved term by term (_SharedForcing); its own right-hand side keeps the rest
+                    # solved term by term (SharedForcing); its own right-hand side keeps the rest
                     if order == system.gauge and state.load[k]:
-                        _subtract(rhs, Branch.constant(domain, state.load[k]))
+                        subtract_into(rhs, Branch.constant(domain, state.load[k]))
                     parts = []
                     ratio = ratios[k]
                     close = abs(float(ratio)) * 1e-6
@@ -630,23 +395,23 @@ class BranchHierarchy(LazyOrders):
                             rhs[key] = rhs[key] + value if key in rhs else value
                         parts.append((weight, part, part.inverses(ratio, near)))
                     own = Branch(domain, rhs).oscillator_particular_solution(system.ratios[k])
-                    components_rhs.append(_Particular(domain, own, parts))
+                    components_rhs.append(Particular(domain, own, parts))
                     continue
                 if projections:
-                    _subtract(rhs, _combination(domain, projections, [forcing[k] for forcing, _ in state.rank_one]))
+                    subtract_into(rhs, combination(domain, projections, [forcing[k] for forcing, _ in state.rank_one]))
                 if order == system.gauge and state.load[k]:
-                    _subtract(rhs, Branch.constant(domain, state.load[k]))
+                    subtract_into(rhs, Branch.constant(domain, state.load[k]))
                 if order >= system.gauge:
                     for element, (forcing, _, _) in enumerate(state.analytic):
                         if forcing[k]:
-                            _subtract(rhs, self._analytic_force(piece, element, order - system.gauge), forcing[k])
+                            subtract_into(rhs, self._analytic_force(piece, element, order - system.gauge), forcing[k])
                     for element, (forcing, _, powers) in enumerate(state.elements):
                         if forcing[k]:
                             for power, coefficient in powers:
-                                _subtract(rhs, self._law_power(piece, element, power, order - system.gauge),
+                                subtract_into(rhs, self._law_power(piece, element, power, order - system.gauge),
                                           coefficient * forcing[k])
                 own = Branch(domain, rhs).oscillator_particular_solution(system.ratios[k])
-                components_rhs.append(_Particular(domain, own, []))
+                components_rhs.append(Particular(domain, own, []))
             particular.append(components_rhs)
 
         def value_of(piece: int, position: int, c: _Affine | None, d: _Affine | None, point: EvaluationPoint,
@@ -803,11 +568,11 @@ class BranchHierarchy(LazyOrders):
         if key not in self._projection_cache:
             if any(cached != order for cached, _ in self._projection_cache):
                 self._projection_cache.clear()
-            self._projection_cache[key] = [_combination(self._domain, previous, coupling) for _, coupling in state.rank_one]
+            self._projection_cache[key] = [combination(self._domain, previous, coupling) for _, coupling in state.rank_one]
         return self._projection_cache[key]
 
     def _shared_forcings(self, order: int, piece: int, state: ContactState,
-                         projections: list[Branch]) -> list[tuple[tuple[Any, ...], _SharedForcing]] | None:
+                         projections: list[Branch]) -> list[tuple[tuple[Any, ...], SharedForcing]] | None:
         """The parts of order ``order``'s right-hand sides on ``piece`` that every component receives with its own
         weight (``(g, S)``: −g_k S for component k): the rank-one projections and the element forces, formed once per
         order and piece; None in an exact field (there every component's right-hand side is one branch)."""
@@ -818,17 +583,17 @@ class BranchHierarchy(LazyOrders):
         if key not in self._shared_cache:
             if any(cached != order for cached, _ in self._shared_cache):
                 self._shared_cache.clear()
-            parts = [(forcing, _SharedForcing(domain, projection))
+            parts = [(forcing, SharedForcing(domain, projection))
                      for (forcing, _), projection in zip(state.rank_one, projections)]
             if order >= gauge:
                 for element, (forcing, _, _) in enumerate(state.analytic):
                     if any(forcing):
-                        parts.append((forcing, _SharedForcing(domain, self._analytic_force(piece, element, order - gauge))))
+                        parts.append((forcing, SharedForcing(domain, self._analytic_force(piece, element, order - gauge))))
                 for element, (forcing, _, powers) in enumerate(state.elements):
                     if any(forcing):
                         laws = [self._law_power(piece, element, power, order - gauge) for power, _ in powers]
-                        law = _combination(domain, laws, [coefficient for _, coefficient in powers])
-                        parts.append((forcing, _SharedForcing(domain, law)))
+                        law = combination(domain, laws, [coefficient for _, coefficient in powers])
+                        parts.append((forcing, SharedForcing(domain, law)))
             self._shared_cache[key] = parts
         return self._shared_cache[key]
 

@@ -15,7 +15,7 @@ permanent contact), chooses the coefficient field — exact: the
 σ_i = sin β_i with σ_i² + κ_i² = 1 (rational or symbolic gaps), else the general
 ``QQ(π, κ, β, sin β, …)`` with independent generators; or a ``RealField`` with
 guard digits near grazing — and hands the
-:class:`~lindstedt.engine.branches.BranchSystem` with N = 1 component to the
+:class:`~lindstedt.engine.branch_system.BranchSystem` with N = 1 component to the
 one branch hierarchy (:mod:`lindstedt.engine.branches`), which solves it order
 by order.
 
@@ -45,7 +45,8 @@ from ..problems.piecewise_linear import PolynomialInterval, decompose_piecewise
 from ..problems.oscillator import DISPLACEMENT, Oscillator
 from ..algebra.branch import EvaluationPoint
 from ..algebra.contact_field import ContactField
-from .branches import BranchHierarchy, BranchSystem, ContactState, MovingBoundary
+from .branch_system import BranchSystem, ContactState, MovingBoundary
+from .branches import BranchHierarchy
 from .stretched import VectorArc
 from .._precision import LOCK, locked, workdps
 

@@ -16,14 +16,14 @@ root); |b_i| = |a0 B_ij| is grazing (double root, validity ~ε^{-1/2}).
 Between consecutive angles the active set is fixed and the law is linear,
 ``ε̂ (L_p W + m_p)`` with ``L_p = Σ_{i active} G_i B_iᵀ`` and
 ``m_p = −Σ_{i active} G_i b_i / a0``: a
-:class:`~lindstedt.engine.branches.BranchSystem` with N components, solved by
+:class:`~lindstedt.engine.branch_system.BranchSystem` with N components, solved by
 the one branch hierarchy.  Its release ``W_{1,j}(0) = a1 λ_j² / a0`` comes from
 ``u_j(0) = a0 + ε a1``.  The arithmetic is a ``RealField`` of the requested
 precision.  Of the modes the normal form needs only the λ_k and the contact
 projections ``B = A Φ``, ``G = Φᵀ W`` (O(N·m) numbers, from
 :meth:`~lindstedt.problems.system.UnilateralSystem.modal_coupling`: float64 modes
 refined in multiprecision), and ``L_p`` enters the hierarchy as its rank-one terms
-``G_i B_iᵀ`` (:class:`~lindstedt.engine.branches.ContactState`), never as an N × N matrix.
+``G_i B_iᵀ`` (:class:`~lindstedt.engine.branch_system.ContactState`), never as an N × N matrix.
 
 **Any law.**  Element i's law ``f_i`` is split at its breakpoints ``p`` into polynomial pieces
 (:func:`~lindstedt.problems.piecewise_linear.decompose_piecewise`); each breakpoint is a candidate boundary, crossed
@@ -58,7 +58,8 @@ from .._errors import ProblemError, ResonanceError, UnsupportedNonlinearityError
 from .._precision import locked, workdps
 from ..problems.system import LAW_VARIABLE, UnilateralSystem
 from ..algebra.branch import Branch, EvaluationPoint
-from .branches import BranchHierarchy, BranchSystem, ContactState, MovingBoundary
+from .branch_system import BranchSystem, ContactState, MovingBoundary
+from .branches import BranchHierarchy
 from .contact import _real_field
 from .stretched import VectorArc
 

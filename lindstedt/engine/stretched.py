@@ -61,10 +61,9 @@ import gmpy2
 import mpmath
 import numpy as np
 import sympy
-from mpmath.libmp import mpf_shift, to_int
 
 from .._errors import ConvergenceError, UnsupportedNonlinearityError
-from .._precision import locked, workdps, workprec
+from .._precision import locked, workdps
 from ..algebra.cosine import _pack
 
 __all__ = ["FloatArc", "VectorArc"]
@@ -268,7 +267,7 @@ class VectorArc:
     coefficient : number
         ĉ.
     polynomial : (load, rank_one, elements)
-        The rest of the law on the arc as in :class:`~lindstedt.engine.branches.ContactState`: a constant load,
+        The rest of the law on the arc as in :class:`~lindstedt.engine.branch_system.ContactState`: a constant load,
         pairs (g, c) adding g (c·Y), and (g, c, ((m, c_m), …)) adding g Σ_m c_m (c·Y)^m.
     digits : int
         Decimal digits wanted.
