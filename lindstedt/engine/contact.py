@@ -601,7 +601,7 @@ def _assemble(
     values = laws + angles + shifts + releases
     if numeric:
         # a float field holds numbers only; ω0 alone may stay symbolic (ε̂ = ε/ω0² scales it out)
-        unknown = set().union(*(sympy.sympify(value, strict=True).free_symbols for value in values)) - problem.omega0.free_symbols
+        unknown = set().union(*(getattr(value, "free_symbols", ()) for value in values)) - problem.omega0.free_symbols
         if unknown:
             names = ", ".join(sorted(str(symbol) for symbol in unknown))
             raise ProblemError(
