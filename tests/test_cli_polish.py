@@ -7,6 +7,7 @@ import pathlib
 import subprocess
 import sys
 
+import mpmath
 import pytest
 
 from lindstedt.cli import build_parser, main
@@ -51,10 +52,16 @@ def test_expand_eps_prints_the_frequency_of_the_expansion(capsys):
     assert _last_value(capsys.readouterr().out, "omega(0.1)") == pytest.approx(1 + 3 / 8 * 0.1 - 21 / 256 * 0.01, rel=1e-15)
     assert main(["expand", "u**3", "--order", "2", "--a0", "1", "--omega0", "1", "--eps", "0.1", "--format", "json"]) == 0
     data = json.loads(capsys.readouterr().out)
-    assert data["evaluated"] == {"epsilon": 0.1, "omega": pytest.approx(1 + 3 / 8 * 0.1 - 21 / 256 * 0.01, rel=1e-15)}
+    # the truncation error's estimate is the first omitted term |ω_3| ε³, ω_3 = 81/2048 (the elliptic series of the
+    # exact frequency π√(1+ε)/(2K(m)), m = ε/(2(1+ε)), which the omitted terms are measured against below)
+    assert data["evaluated"] == {"epsilon": 0.1, "omega": pytest.approx(1 + 3 / 8 * 0.1 - 21 / 256 * 0.01, rel=1e-15),
+                                 "truncation_error_estimate": pytest.approx(81 / 2048 * 0.1**3, rel=1e-12)}
     assert data["omega"] == ["1", "3/8", "-21/256"]
+    exact = float(mpmath.pi * mpmath.sqrt(1.1) / (2 * mpmath.ellipk(mpmath.mpf("0.1") / 2.2)))
+    error = abs(exact - data["evaluated"]["omega"])
+    assert 0.5 * data["evaluated"]["truncation_error_estimate"] <= error <= 2 * data["evaluated"]["truncation_error_estimate"]
     assert main(["expand", "u**3", "--order", "1", "--a0", "1", "--omega0", "1", "--eps", "0.1", "--format", "latex"]) == 0
-    assert r"\omega(0.1) \approx 1.0375" in capsys.readouterr().out
+    assert r"\omega(0.1) \approx 1.0375 \quad (\text{truncation error} \approx 0.00082)" in capsys.readouterr().out
 
 
 def test_expand_eps_warns_in_one_line_where_the_series_diverges(capsys):

@@ -5,7 +5,7 @@ Sub-commands
 ``lindstedt expand F --order N [--a0 A] [--omega0 W] [--param NAME=VALUE ...]
 [--normalization initial|harmonic] [--eps E] [--format pretty|plain|latex|json]``
     Lindstedt–Poincaré expansion of the oscillator with nonlinearity F; ``--eps E`` also
-    prints ω(E) evaluated from the expansion.  Text output is pretty (Unicode, 2-D
+    prints ω(E) evaluated from the expansion, with the estimate of its truncation error.  Text output is pretty (Unicode, 2-D
     formulas) by default; ``--format plain`` (alias ``text``) prints Python syntax.
     ``--u0 U --v0 V`` instead of ``--a0``: the orbit through u(0) = U, u'(0) = V
     (its turning-point and phase series are printed too).
@@ -53,6 +53,7 @@ Nothing is written to disk unless asked (``derive --output DIR``, ``demo --figur
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from typing import Any, Sequence
 
@@ -129,7 +130,8 @@ def build_parser() -> argparse.ArgumentParser:
     expand.add_argument("--v0", default=None,
                         help="initial velocity u'(0): the orbit through (u0, v0), with its turning-point and phase series")
     expand.add_argument("--eps", default=None, metavar="E",
-                        help="also print omega(E), the expansion's frequency at eps = E (needs numeric --a0, --omega0 and parameter values)")
+                        help="also print omega(E), the expansion's frequency at eps = E, and its truncation error's estimate "
+                             "(needs numeric --a0, --omega0 and parameter values)")
     expand.add_argument("--format", choices=FORMATS, default="pretty", help=FORMAT_HELP)
     expand.add_argument("--waveforms", action="store_true", help="include the waveforms v_k in text/LaTeX output")
     expand.add_argument("--precision", type=int, default=30, help="decimal digits for non-polynomial f (default 30)")
@@ -145,7 +147,7 @@ def build_parser() -> argparse.ArgumentParser:
                      "unilateral springs, DOP853 with variational equations for other laws)")
     nnm.add_argument("--energy", default=None, help="with --numeric: prescribed energy instead of --a0")
     nnm.add_argument("--eps", default=None, metavar="E",
-                     help="the value of epsilon: the expansion's frequency at E, or with --numeric the orbit at E (required there)")
+                     help="the value of epsilon: the expansion's frequency at E with its truncation error's estimate, or with --numeric the orbit at E (required there)")
     nnm.add_argument("--order", type=int, default=2, help="expansion order (default 2)")
     nnm.add_argument("--precision", type=int, default=30, help="decimal digits of the arithmetic (default 30)")
     nnm.add_argument("--format", choices=FORMATS, default="pretty", help=FORMAT_HELP + " (--numeric: pretty, plain and latex print its summary)")
@@ -229,24 +231,37 @@ def _expand_output(arguments: argparse.Namespace, expansion: Any, progress: Prog
         import json
 
         data = expansion.to_dict()
-        data["evaluated"] = {"epsilon": evaluated[0], "omega": evaluated[1]}
+        data["evaluated"] = _evaluated_json(*evaluated)
         return json.dumps(data, indent=2, allow_nan=False)
     if arguments.format == "latex":
         text = expansion.to_latex(waveforms=arguments.waveforms)
-        if evaluated is not None:
-            text = text.rstrip("\n") + f"\n\\[ \\omega({evaluated[0]!r}) \\approx {evaluated[1]!r} \\]"
-        return text
+        return text if evaluated is None else text.rstrip("\n") + _evaluated_latex(*evaluated)
     if arguments.format == "pretty":
         text = _pretty_expansion(expansion, waveforms=arguments.waveforms)
-        if evaluated is not None:
-            text += f"\nω(ε = {evaluated[0]!r}) = {evaluated[1]!r}"
-        return text
+        return text if evaluated is None else text + _evaluated_text(*evaluated, pretty=True)
     text = expansion.summary()
     if arguments.waveforms:
         text += "\n" + "\n".join(f"  v_{w.order}(s) = {w.to_expr()}" for w in expansion.waveforms)
-    if evaluated is not None:
-        text += f"\nomega({evaluated[0]!r}) = {evaluated[1]!r}"
-    return text
+    return text if evaluated is None else text + _evaluated_text(*evaluated, pretty=False)
+
+
+def _evaluated_text(epsilon: float, omega: float, error: float, pretty: bool) -> str:
+    """ω(ε) and, on a line of its own, the estimate of its truncation error (the terms beyond the order)."""
+    head = f"ω(ε = {epsilon!r}) = {omega!r}" if pretty else f"omega({epsilon!r}) = {omega!r}"
+    return f"\n{head}\n  truncation error estimate: {error:.3g} (the omitted terms of the series)"
+
+
+def _evaluated_latex(epsilon: float, omega: float, error: float) -> str:
+    return f"\n\\[ \\omega({epsilon!r}) \\approx {omega!r} \\quad (\\text{{truncation error}} \\approx {_latex_number(error)}) \\]"
+
+
+def _latex_number(value: float) -> str:
+    mantissa, _, exponent = f"{value:.3g}".partition("e")
+    return mantissa if not exponent else f"{mantissa} \\times 10^{{{int(exponent)}}}"
+
+
+def _evaluated_json(epsilon: float, omega: float, error: float) -> dict[str, Any]:
+    return {"epsilon": epsilon, "omega": omega, "truncation_error_estimate": error if math.isfinite(error) else None}
 
 
 def _pretty(expression: Any) -> str:
@@ -337,8 +352,9 @@ def _subscript(number: int) -> str:
     return str(number).translate(str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉"))
 
 
-def _evaluate_expansion(expansion: Any, eps_text: str) -> tuple[float, float]:
-    """(ε, ω(ε)) from the expansion; its validity warnings become one ``warning:`` line on stderr."""
+def _evaluate_expansion(expansion: Any, eps_text: str) -> tuple[float, float, float]:
+    """(ε, ω(ε), the truncation error's estimate) from the expansion; its validity warnings become one ``warning:``
+    line on stderr."""
     from ..problems.parsing import parse_float
 
     epsilon = parse_float(eps_text, what="--eps")
@@ -350,7 +366,8 @@ def _evaluate_expansion(expansion: Any, eps_text: str) -> tuple[float, float]:
                 f"--eps evaluates the expansion, which needs numbers for {', '.join(free)}: "
                 "give --a0 A and --omega0 W as numbers and every --param as NAME=VALUE"
             )
-    return epsilon, _warned(lambda: float(expansion.frequency(epsilon)))
+    return (epsilon, *_warned(lambda: (float(expansion.frequency(epsilon)),
+                                       float(expansion.truncation_error_estimate(epsilon)))))
 
 
 def _free_symbols(problem: Any) -> set:
@@ -434,23 +451,22 @@ def _nnm_output(system: Any, arguments: argparse.Namespace) -> str | tuple[str, 
 
         epsilon = parse_float(arguments.eps, what="--eps")
     result = nnm(system, arguments.mode, arguments.a0, arguments.order, precision=arguments.precision)
-    value = None if epsilon is None else _warned(lambda: float(result.frequency(epsilon)))
+    evaluated = None if epsilon is None else (epsilon, *_warned(
+        lambda: (float(result.frequency(epsilon)), float(result.truncation_error_estimate(epsilon)))))
     if arguments.format == "json":
-        if value is None:
+        if evaluated is None:
             return result.to_json()
         data = json.loads(result.to_json())
-        data["evaluated"] = {"epsilon": epsilon, "omega": value}
+        data["evaluated"] = _evaluated_json(*evaluated)
         return json.dumps(data, indent=2, allow_nan=False)
     if arguments.format == "latex":
         text = result.to_latex()
-        if value is not None:
-            text = text.rstrip("\n") + f"\n\\[ \\omega({epsilon!r}) \\approx {value!r} \\]"
-        return text
+        return text if evaluated is None else text.rstrip("\n") + _evaluated_latex(*evaluated)
     if arguments.format == "pretty":
         text = _pretty_nnm(result)
-        return text if value is None else text + f"\nω(ε = {epsilon!r}) = {value!r}"
+        return text if evaluated is None else text + _evaluated_text(*evaluated, pretty=True)
     text = result.summary()
-    return text if value is None else text + f"\nomega({epsilon!r}) = {value!r}"
+    return text if evaluated is None else text + _evaluated_text(*evaluated, pretty=False)
 
 
 def _command_derive(arguments: argparse.Namespace) -> str | tuple[str, int]:
@@ -517,6 +533,7 @@ def main(argv: Sequence[str] | None = None) -> int:
       omega_0 = 1
       omega_1 = 3/8
     omega(0.1) = 1.0375
+      truncation error estimate: 0.00082 (the omitted terms of the series)
     0
     """
     import warnings
