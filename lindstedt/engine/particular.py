@@ -14,11 +14,11 @@ from itertools import repeat
 from typing import Any, Sequence
 
 import gmpy2
-from mpmath.libmp import from_man_exp
 
+from .._mpfr import mpfr_of_mpf, raw_of_mpfr
 from ..algebra.branch import Branch, EvaluationPoint, domain_constant
 
-__all__ = ["Particular", "SharedForcing", "combination", "subtract_into", "to_mpfr"]
+__all__ = ["Particular", "SharedForcing", "combination", "subtract_into"]
 
 
 def combination(domain: Any, branches: Sequence[Branch], weights: Sequence[Any]) -> Branch:
@@ -40,15 +40,6 @@ def subtract_into(terms: dict, branch: Branch, factor: Any = None) -> None:
         for key, value in branch.terms.items():
             value = -(value * factor)
             terms[key] = terms[key] + value if key in terms else value
-
-
-def to_mpfr(value: Any) -> Any:
-    """A float field's element (or an int) as a gmpy2 mpfr, exactly (in a gmpy2 context of the field's precision)."""
-    if isinstance(value, int):
-        return gmpy2.mpfr(value)
-    sign, mantissa, exponent, _ = value._mpf_
-    result = gmpy2.mul_2exp(gmpy2.mpfr(mantissa), exponent)
-    return -result if sign else result
 
 
 class SharedForcing:
@@ -75,7 +66,7 @@ class SharedForcing:
         self.groups = list(groups.values())
         self.floats = sorted((float(harmonic), g) for g, harmonic in enumerate(groups))  # (ν, group) by ν
         with gmpy2.context(precision=self.precision):
-            self.squares = [to_mpfr(harmonic * harmonic) for harmonic in groups]  # ν² rounded as the field rounds it
+            self.squares = [mpfr_of_mpf(harmonic * harmonic) for harmonic in groups]  # ν² rounded as the field rounds it
         self.others = [(key, value) for key, value in branch.terms.items() if key[2]]
         self._products: dict[tuple[EvaluationPoint, bool], list[Any]] = {}
 
@@ -88,7 +79,7 @@ class SharedForcing:
     def inverses(self, ratio: Any, near: list[int]) -> list[Any]:
         """``1/(r² − ν²)`` for every harmonic (mpfr; zero for the groups ``near``, solved by the component)."""
         with gmpy2.context(precision=self.precision):
-            squared = to_mpfr(ratio * ratio)
+            squared = mpfr_of_mpf(ratio * ratio)
             result = list(map(gmpy2.div, repeat(gmpy2.mpfr(1), len(self.squares)), map(gmpy2.sub, repeat(squared),
                                                                                           self.squares)))
             for g in near:
@@ -113,7 +104,7 @@ class SharedForcing:
                     total = product if total is None else total + product
                 cached.append(total)
             with gmpy2.context(precision=self.precision):
-                cached = [to_mpfr(product) for product in cached]
+                cached = [mpfr_of_mpf(product) for product in cached]
             self._products[key] = cached
         return cached
 
@@ -121,8 +112,7 @@ class SharedForcing:
         """Σ_ν u_ν/(r² − ν²) at ``point`` (a field element) for the inverses of one component."""
         with gmpy2.context(precision=self.precision):
             total = gmpy2.fsum(map(gmpy2.mul, self.products(point, slope), inverses))
-        mantissa, exponent = total.as_mantissa_exp()
-        return self.domain.from_raw(from_man_exp(int(mantissa), int(exponent)))
+        return self.domain.from_raw(raw_of_mpfr(total))
 
 
 class Particular:
@@ -159,8 +149,7 @@ class Particular:
         for weight, forcing, inverses in self.shared:
             for group, inverse in zip(forcing.groups, inverses):
                 if inverse:
-                    mantissa, exponent = inverse.as_mantissa_exp()
-                    inverse = domain.from_raw(from_man_exp(int(mantissa), int(exponent)))
+                    inverse = domain.from_raw(raw_of_mpfr(inverse))
                     for key, value in group:
                         value = weight * (value * inverse)
                         terms[key] = terms[key] + value if key in terms else value

@@ -63,6 +63,7 @@ import numpy as np
 import sympy
 
 from .._errors import ConvergenceError, UnsupportedNonlinearityError
+from .._mpfr import mpf_of_mpfr, mpfr_of_mpf
 from .._precision import locked, workdps
 from ..algebra.cosine import _pack
 
@@ -75,17 +76,9 @@ _TWO = gmpy2.mpfr(2)
 
 
 def _mpfr(value: Any) -> Any:
-    """An mpmath number (or anything mpmath reads) as a gmpy2 mpfr of the current gmpy2 precision, exactly when the
-    mantissa fits."""
-    sign, mantissa, exponent, _ = mpmath.mpf(value)._mpf_
-    result = gmpy2.mul_2exp(gmpy2.mpfr(mantissa), exponent)
-    return -result if sign else result
-
-
-def _mpf(value: Any) -> Any:
-    """A gmpy2 mpfr as an mpmath mpf (exact at mpmath's current precision ≥ the mpfr's)."""
-    mantissa, exponent = value.as_mantissa_exp()
-    return mpmath.mpf((int(mantissa), int(exponent)))
+    """An mpmath number (or anything mpmath reads, at mpmath's working precision) as a gmpy2 mpfr of the current
+    gmpy2 precision, exactly when the mantissa fits."""
+    return mpfr_of_mpf(mpmath.mpf(value))
 
 
 def _array(values: Sequence[Any]) -> np.ndarray:
@@ -434,7 +427,7 @@ class VectorArc:
                 derivative = sympy.diff(expression, symbol, len(terms))
                 scale = sympy.Integer(math.factorial(len(terms)))
                 terms.append(sympy.lambdify(symbol, derivative / scale, modules="mpmath"))
-            values = [mpmath.mpf(terms[k](_mpf(y))) for y in self._projection(coupling, 0)]
+            values = [mpmath.mpf(terms[k](mpf_of_mpfr(y))) for y in self._projection(coupling, 0)]
             if not all(mpmath.isfinite(value) for value in values):
                 raise UnsupportedNonlinearityError(
                     f"the law {expression} is not analytic on the contact arc (derivative {k} is not finite there)")
@@ -592,7 +585,7 @@ class VectorArc:
                 data = self._particular(order, tolerance) if self.tail <= tolerance else None
                 if data is not None:
                     self._pending = (order, data)
-                    return [(_mpf(item["end"]), _mpf(item["end_slope"])) for item in data]
+                    return [(mpf_of_mpfr(item["end"]), mpf_of_mpfr(item["end_slope"])) for item in data]
             self._refine(order)
 
     @locked
@@ -650,7 +643,7 @@ class VectorArc:
                 on = component == self.mode
                 values, slopes = self._coefficients(cosine if on else self._zero,
                                                     -self._omega[component] * sine if on else self._zero)
-            return [_mpf(a) for a in values], [_mpf(a) for a in slopes]
+            return [mpf_of_mpfr(a) for a in values], [mpf_of_mpfr(a) for a in slopes]
 
     @locked
     def float_arcs(self, highest: int) -> tuple[FloatArc, ...]:

@@ -57,6 +57,7 @@ import sympy
 
 from .._budget import Estimate, checkpoint
 from .._errors import ProblemError
+from .._mpfr import mpf_of_mpfr, mpfr_of_mpf
 from .._precision import warn_caller
 from .modes import _leading_sign, _leading_signs
 from .system import UnilateralSystem
@@ -298,16 +299,6 @@ def _rows_times(entries: dict[tuple[int, int], Any], rows: int, columns: np.ndar
     return result
 
 
-def _to_mpmath(value: Any) -> Any:
-    mantissa, exponent = value.as_mantissa_exp()
-    return mpmath.ldexp(mpmath.mpf(int(mantissa)), int(exponent))
-
-
-def _to_mpfr(value: Any) -> Any:
-    gmpy2 = _gmpy2()
-    value = mpmath.mpf(value)
-    mantissa, exponent = value.man_exp  # the mantissa's magnitude
-    return gmpy2.mul_2exp(gmpy2.mpfr(-int(mantissa) if value < 0 else int(mantissa)), int(exponent))
 
 
 def _exact(value: Any) -> sympy.Rational:
@@ -587,7 +578,7 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
             gram, U = mpmath.eigsy(_small(Z.T.dot(product.times(Z))))
             largest = max(gram[i] for i in range(gram.rows))
             keep = [i for i in range(gram.rows) if gram[i] > largest * mpmath.mpf(2) ** (-target)]
-            scale = np.array([[_to_mpfr(U[r, i] / mpmath.sqrt(gram[i])) for i in keep] for r in range(gram.rows)], dtype=object)
+            scale = np.array([[mpfr_of_mpf(mpmath.mpf(U[r, i] / mpmath.sqrt(gram[i]))) for i in keep] for r in range(gram.rows)], dtype=object)
             Z, KZ = Z.dot(scale), KZ.dot(scale)
             signs = _leading_signs(Z.astype(float)).astype(object)  # signed as the modes (eigsy's signs are arbitrary)
             Z, KZ = Z * signs, KZ * signs
@@ -601,7 +592,7 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
             reduced_loads = _rows_times({(c, i): value for c, load in enumerate(loads) for i, value in load.items()},
                                         len(loads), V).T
             basis = V.astype(float)
-            frequencies = tuple(_to_mpmath(gmpy2.sqrt(value)) for value in values[:K])
+            frequencies = tuple(mpf_of_mpfr(gmpy2.sqrt(value)) for value in values[:K])
 
         def exact(matrix: np.ndarray, symmetric: bool) -> sympy.Matrix:
             if symmetric:
@@ -627,7 +618,7 @@ def _reduce(method: ResidualFlexibility, n: int, m: int, mass: dict, stiffness: 
 def _small(matrix: np.ndarray) -> Any:
     """A small symmetric object matrix of mpfr as an mpmath matrix (symmetrised)."""
     size = matrix.shape[0]
-    return mpmath.matrix([[(_to_mpmath(matrix[i, j]) + _to_mpmath(matrix[j, i])) / 2 for j in range(size)] for i in range(size)])
+    return mpmath.matrix([[(mpf_of_mpfr(matrix[i, j]) + mpf_of_mpfr(matrix[j, i])) / 2 for j in range(size)] for i in range(size)])
 
 
 def _cholesky(matrix: np.ndarray) -> np.ndarray:
