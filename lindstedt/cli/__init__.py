@@ -256,6 +256,8 @@ def _evaluated_latex(epsilon: float, omega: float, error: float) -> str:
 
 
 def _latex_number(value: float) -> str:
+    """``value`` to 3 significant digits in LaTeX (sympy.latex(Float(v, 3)) rounds the binary value at ~10 bits:
+    3.955e-5 printed 3.95)."""
     mantissa, _, exponent = f"{value:.3g}".partition("e")
     return mantissa if not exponent else f"{mantissa} \\times 10^{{{int(exponent)}}}"
 
