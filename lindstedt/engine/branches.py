@@ -69,7 +69,7 @@ from .orders import LazyOrders, shift_powers, sum_of_products
 from .affine import _Affine, solve_linear
 from .branch_system import BranchSystem, ContactState, MovingBoundary
 from .float_branches import FloatBranches
-from .particular import Particular, SharedForcing, combination, subtract_into
+from .particular import Particular, SharedForcing, add_scaled, combination, subtract_into
 
 __all__ = ["BranchHierarchy"]
 
@@ -387,12 +387,8 @@ class BranchHierarchy(LazyOrders):
                         weight = -forcing[k]
                         near = part.near(float(ratio), close)
                         for group in near:  # (near) resonance: the general solution
-                            for key, value in part.groups[group]:
-                                value = weight * value
-                                rhs[key] = rhs[key] + value if key in rhs else value
-                        for key, value in part.others:
-                            value = weight * value
-                            rhs[key] = rhs[key] + value if key in rhs else value
+                            add_scaled(rhs, part.groups[group], weight)
+                        add_scaled(rhs, part.others, weight)
                         parts.append((weight, part, part.inverses(ratio, near)))
                     own = Branch(domain, rhs).oscillator_particular_solution(system.ratios[k])
                     components_rhs.append(Particular(domain, own, parts))

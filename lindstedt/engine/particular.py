@@ -11,14 +11,21 @@ from __future__ import annotations
 
 from bisect import bisect_left, bisect_right
 from itertools import repeat
-from typing import Any, Sequence
+from typing import Any, Iterable, Sequence
 
 import gmpy2
 
 from .._mpfr import mpfr_of_mpf, raw_of_mpfr
 from ..algebra.branch import Branch, EvaluationPoint, domain_constant
 
-__all__ = ["Particular", "SharedForcing", "combination", "subtract_into"]
+__all__ = ["Particular", "SharedForcing", "add_scaled", "combination", "subtract_into"]
+
+
+def add_scaled(terms: dict, pairs: Iterable[tuple[Any, Any]], weight: Any) -> None:
+    """terms += weight · value for every (key, value) of ``pairs``, in place."""
+    for key, value in pairs:
+        value = weight * value
+        terms[key] = terms[key] + value if key in terms else value
 
 
 def combination(domain: Any, branches: Sequence[Branch], weights: Sequence[Any]) -> Branch:
@@ -26,8 +33,7 @@ def combination(domain: Any, branches: Sequence[Branch], weights: Sequence[Any])
     terms: dict = {}
     for branch, weight in zip(branches, weights):
         if weight:
-            for key, value in branch.terms.items():
-                terms[key] = terms[key] + value * weight if key in terms else value * weight
+            add_scaled(terms, branch.terms.items(), weight)
     return Branch(domain, terms)
 
 
