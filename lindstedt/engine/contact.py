@@ -50,7 +50,7 @@ from .branches import BranchHierarchy
 from .stretched import VectorArc
 from .._precision import LOCK, locked, workdps
 
-__all__ = ["ContactBoundary", "PiecewiseNormalForm", "contact_normal_form"]
+__all__ = ["ContactBoundary", "PiecewiseNormalForm", "contact_normal_form", "real_field"]
 
 _ARC_VARIABLE = sympy.Symbol("y", real=True)  # the normalised displacement in an arc's analytic law
 
@@ -136,7 +136,7 @@ class _ConstantField:
         self.contact_field: ContactField | None = None
         if self.numeric:
             self.digits = digits or 30
-            self.domain = _real_field(self.digits)
+            self.domain = real_field(self.digits)
             return
         self.digits = None
         try:
@@ -305,7 +305,7 @@ class _FloatField(RealField):
 _REAL_FIELDS: dict[int, Any] = {}
 
 
-def _real_field(digits: int) -> Any:
+def real_field(digits: int) -> Any:
     """``RealField(dps=digits)`` (:class:`_FloatField`), made once per digits (each makes its own mpmath context,
     ~0.5 ms)."""
     field = _REAL_FIELDS.get(digits)

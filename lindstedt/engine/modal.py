@@ -60,7 +60,7 @@ from ..problems.system import LAW_VARIABLE, UnilateralSystem
 from ..algebra.branch import Branch, EvaluationPoint
 from .branch_system import BranchSystem, ContactState, MovingBoundary
 from .branches import BranchHierarchy
-from .contact import _real_field
+from .contact import real_field
 from .stretched import VectorArc
 
 __all__ = ["ModalNormalForm", "SpringAtOrderZero", "modal_guard_digits", "modal_normal_form"]
@@ -246,7 +246,7 @@ def _classify(index: int, coupling: Any, gap: Any, digits: int, mode: int, eleme
 @locked
 def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, release_correction: Any, digits: int) -> ModalNormalForm:
     """The modal normal form of the NNM of ``mode`` (0-based) released at u_j(0) = a0 + ε a1, in ``digits`` digits."""
-    domain = _real_field(digits)  # a RealField with the fused sum of products (the same bits, ~2.5 times faster)
+    domain = real_field(digits)  # a RealField with the fused sum of products (the same bits, ~2.5 times faster)
     size, springs_count = system.n_dof, system.n_springs
 
     def convert(value: Any) -> Any:
