@@ -57,7 +57,7 @@ import sympy
 from .._errors import ProblemError, ResonanceError, UnsupportedNonlinearityError
 from .._precision import locked, workdps
 from ..problems.system import LAW_VARIABLE, UnilateralSystem
-from ..algebra.branch import Branch, EvaluationPoint
+from ..algebra.branch import Branch, EvaluationPoint, key_harmonic
 from .branch_system import BranchSystem, ContactState, MovingBoundary
 from .branches import BranchHierarchy
 from .contact import real_field
@@ -258,7 +258,7 @@ def modal_normal_form(system: UnilateralSystem, mode: int, amplitude: Any, relea
     frequencies = [domain.dtype(value) for value in lambdas]
     a0 = convert(amplitude)
     lam = frequencies[mode]
-    ratios = [value / lam for value in frequencies]
+    ratios = [key_harmonic(value / lam) for value in frequencies]  # term keys' frequencies, their hash remembered
     small_divisors = _small_divisors(ratios, mode)
     gaps = [convert(v) for v in list(system.b_exact)]
     B = [[domain.dtype(value) for value in row] for row in coupling_rows]  # B[i][k]
