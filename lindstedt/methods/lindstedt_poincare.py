@@ -104,7 +104,9 @@ def clear_cache() -> None:
 
     ``lindstedt.expand`` keeps the hierarchies of the last :data:`CACHE_MAXSIZE`
     (64) problems, so that asking again, or to a higher order, reuses the work
-    done.  Results are the same with or without the cache; clearing frees the
+    done (float expansions of polynomial pieces, ``numeric=True`` on gaps, about a
+    millisecond each, are derived afresh instead).  Results are the same with or
+    without the cache; clearing frees the
     memory and makes the next expansion start from scratch (e.g. for timing).
 
     Examples
@@ -165,7 +167,9 @@ class LindstedtPoincare:
     One verb: :meth:`expand`.  The hierarchy behind it is cached (process-wide,
     the last :data:`CACHE_MAXSIZE` problems, see :func:`clear_cache`), so
     expanding the same problem again, or to a higher order, reuses all the work
-    already done.
+    already done — except a float hierarchy of polynomial pieces (``numeric=True``
+    on gaps and clearances), which costs about a millisecond to derive and is
+    derived afresh rather than kept.
 
     Parameters
     ----------
@@ -215,10 +219,18 @@ class LindstedtPoincare:
         problem_key = _problem_key(problem)
         if problem.is_non_smooth:
             # exact unless asked for floats or a piece is not polynomial (Hertz, exp: its contact arc is numeric)
-            if not (self.numeric or has_non_polynomial_law(problem.nonlinearity, DISPLACEMENT)):
+            contact_law = has_non_polynomial_law(problem.nonlinearity, DISPLACEMENT)
+            if not (self.numeric or contact_law):
                 # Exact: the normal form does not depend on the order; it is built only on a miss
                 # (its domain has fresh Dummy generators and must not enter the key).
                 key, make_form = (problem_key, "piecewise", None), lambda: contact_normal_form(problem, None)
+            elif not contact_law:
+                # Polynomial pieces in floats: derived afresh (~1.4 ms to order 4, 36 ms to order 20), not kept.
+                # Kept, a sweep over a parameter turns the cache over at every value, and the evicted hierarchies
+                # (~1000 objects each) outlive the young generations: measured over 600 new κ, median 1.47 →
+                # 1.35 ms, 99th percentile 6.2 → 1.6 ms, worst 46 → 8 ms (full garbage collections).
+                form = contact_normal_form(problem, self.precision, order_hint=order + 1)
+                return form, BranchHierarchy(form.system, problem.normalization)
             else:
                 # Float: the working digits (precision + guard digits near grazing, which grow with
                 # the order) decide the hierarchy; the float normal form is cheap, build it to know them.
