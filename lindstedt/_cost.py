@@ -269,15 +269,18 @@ def _advice(problem: Any, features: ExpansionFeatures, precision: int) -> str:
 #: (orders 1, 2), 0.60 s at 500, 1.40 s at 1000, ~4.5 s at 2000; from order 3 the hierarchy's combination tones
 #: dominate: after the shared right-hand sides of the order solve (issue 26) 0.49 / 0.79 / 2.09 s CPU at
 #: N = 50 / 100 / 200 (order 3; it was 0.6 / 1.55 / 5.5 s, N^1.6) and ×2.2–2.5 an order (N = 50: 1.22 s at order 4,
-#: 2.65 s at 5); estimate/measured 0.9–1.4.  The coupling hardly depends on S (1000 dof, order 2: 1.28 s with one spring, 1.40 s with three;
-#: 200 dof: 0.21 / 0.30 / 0.35 s with 1 / 3 / 6); the tones' springs exponent is the earlier fit's.  The constants carry
-#: 1.2–1.5× of margin.
-_NNM = (3.4e-4, 1.9e-3)
+#: 2.65 s at 5).  The coupling hardly depends on S (1000 dof, order 2: 1.28 s with one spring, 1.40 s with three;
+#: 200 dof: 0.21 / 0.30 / 0.35 s with 1 / 3 / 6); the tones' springs exponent is the earlier fit's.  Session 14
+#: (term-key harmonics that remember their hash, memoised particular solutions): order 3 CPU 0.19 / 0.39 / 1.24 s at
+#: N = 50 / 100 / 200, estimate/measured 1.2–1.6 with _NNM[1] refitted.
+_NNM = (3.4e-4, 1.4e-3)
 #: Its memory: the float modal matrices (``_NNM_MEMORY[0] · N²`` MB: the modes, their gaps and projections; the
 #: fixed-point shapes are refined a block at a time — chain of 1000 dof 59–65 MB, 2000 dof 106 MB measured over the
-#: import baseline, so the N² term keeps a margin of 1.5–4×) or the hierarchy
-#: (``_NNM_MEMORY[1] · T^0.9`` MB).
-_NNM_MEMORY = (1e-4, 12.0)
+#: import baseline, so the N² term keeps a margin of 1.5–4×) or the hierarchy, whose peak grows with its work:
+#: measured 41–57 MB per CPU second at orders 3 and 4 (springs only, 50…200 dof: 9 / 18 / 51 MB; Hertz + cubic, all
+#: modes, order 3, 20 / 40 / 80 dof: 62 / 283 / 1372 MB; order 4, 20 dof: 640 MB), so ``_NNM_MEMORY[1] · T`` MB of
+#: the estimated T: estimate/measured 1.6–2.4 on those (it was ``12 T^0.9``: half the 80-dof peak).
+_NNM_MEMORY = (1e-4, 60.0)
 
 
 #: Elements of other laws.  A stretched contact arc (a law with a fractional power, or an analytic part next to a
@@ -290,10 +293,9 @@ _NNM_MEMORY = (1e-4, 12.0)
 #: 0.80 / 0.89 / 1.86 s.  Estimate/measured 0.6–1.2 with all modes, 0.9–2.9 reduced (a small contact angle β
 #: there needs fewer nodes than r_max says; β is known only once the orbit is).  Products of branches (powers ≥ 2,
 #: analytic laws) cost ``_NNM_PRODUCTS · N² · 9^(order − 2)`` s from order 3 on (combination tones of the N modal
-#: frequencies; the benchmark chain, Hertz + cubic, order 3: 2.6 / 11.2 / 45.9 s at N = 20 / 40 / 80, N^2.0; a
-#: sin(u) element on a 5-dof chain 0.44 s at order 3, 2.24 s at order 4: estimate/measured 0.8–2); order 2 stays
-#: linear in N.
-_NNM_ARC, _NNM_PRODUCTS = (0.3, 2e-4), 1.5e-3
+#: frequencies; the benchmark chain, Hertz + cubic, order 3: 1.23 / 5.9 / 24.3 s CPU at N = 20 / 40 / 80 (session
+#: 14; it was 2.6 / 11.2 / 45.9), order 4 at N = 20 15.1 s: estimate/measured 1.1–1.9); order 2 stays linear in N.
+_NNM_ARC, _NNM_PRODUCTS = (0.3, 2e-4), 5e-4
 
 
 def _law_costs(system: Any) -> tuple[int, bool]:
@@ -336,7 +338,7 @@ def nnm_estimate(system: Any, mode: int, order: int) -> Estimate:
         seconds += (_NNM_ARC[0] + _NNM_ARC[1] * n * stiffest) * (order + 1) / 3
     if products and order >= 3:
         seconds += _NNM_PRODUCTS * n**2 * 9.0 ** (order - 2)
-    memory = max(1.0, _NNM_MEMORY[0] * n * n, _NNM_MEMORY[1] * seconds**0.9)
+    memory = max(1.0, _NNM_MEMORY[0] * n * n, _NNM_MEMORY[1] * seconds)
     return Estimate(task=f"NNM expansion of mode {mode} of a {n}-dof system to order {order}", seconds=seconds,
                     memory_mb=memory, drivers=(("degrees of freedom", n), ("springs", springs), ("order", order)),
                     advice="ask for a lower order, or reduce the model (fewer degrees of freedom)")
