@@ -274,10 +274,11 @@ print(json.dumps([estimate.memory_mb, peak]))
 @pytest.mark.slow
 @pytest.mark.parametrize("size, order, laws", [(100, 3, False), (20, 3, True)])
 def test_the_memory_an_nnm_expansion_is_priced_at_bounds_its_peak(size, order, laws):
-    """The price is the budget's only protection (a refusal happens before any work): the peak resident memory of a
-    fresh process over its baseline after the system is built must stay below it.  At order 3 the peak grows with
-    the work (the combination tones of the modal frequencies), ~50 MB per CPU second measured; the earlier model
-    priced these two at 11 and 61 MB, measured 18 and 62."""
+    """The checkpoints between orders see the memory only once an order is solved, and the top order is most of an
+    NNM's peak: its price is what guards it.  The peak resident memory of a fresh process over its baseline after
+    the system is built stays below the price (memory does not depend on the machine's speed).  At order 3 the peak
+    grows with the work (the combination tones of the modal frequencies), ~50 MB per CPU second measured; the
+    earlier model priced these two at 11 and 61 MB, measured 18 and 62."""
     import json
     import subprocess
     import sys
