@@ -425,7 +425,7 @@ def _worker_nnm(spec: dict[str, Any]) -> None:
         reduced = lindstedt.ResidualFlexibility(modes=spec["reduce"], digits=30).reduce(
             (system.M, system.K), A=system.A, b=system.b, W=system.W, laws=list(system.laws))
         system = reduced.system
-    result = lindstedt.nnm(system, mode=mode, a0=1.0, order=2)
+    result = lindstedt.nnm(system, mode=mode, a0=1.0, order=spec.get("order", 2))
     omega = [float(value) for value in result.omega]
     seconds = time.perf_counter() - start
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
@@ -765,10 +765,14 @@ def run(quick: bool = False) -> str:
             floor_lines.append(f"| {precision} | {_t(worst[precision][0])} | {_t(quarter['worst'])} | {ratio_quarter:.1f}× | "
                                f"{_t(cheapest['worst'])} | {ratio_cheapest:.1f}× | "
                                f"{_e(max(quarter['relative_error'], cheapest['relative_error']))}{'' if agrees else ' (NOT to the digits)'} | {general} |")
-            summary.append((f"numeric ω1…ω4 at a new κ (precision={precision}), against the same-digit Cauchy floor",
-                            _t(worst[precision][0]), _t(cheapest["worst"]) + f" (Cauchy integral of the exact period, {precision} digits, "
-                            f"6 nodes on r = R/10⁷; on r = R/4 as in the audit: {_t(quarter['worst'])})",
-                            f"{ratio_cheapest:.1f}× ({ratio_quarter:.1f}× the r = R/4 one)", _verdict(ratio_cheapest <= 1 and agrees)))
+            # judged as the issue states it: against the audit's same-digit floor (the Cauchy integral of the exact
+            # period on r = R/4); the cheapest rule found (6 nodes on r = R/10⁷) is shown beside it, not judged
+            summary.append((f"numeric ω1…ω4 at a new κ (precision={precision}), against the same-digit Cauchy floor of the audit",
+                            _t(worst[precision][0]), _t(quarter["worst"]) + f" (Cauchy integral of the exact period, {precision} "
+                            "digits, r = R/4 as in the issue's audit)", f"{ratio_quarter:.1f}×", _verdict(ratio_quarter <= 1 and agrees)))
+            summary.append((f"numeric ω1…ω4 at a new κ (precision={precision}), against the cheapest Cauchy rule found",
+                            _t(worst[precision][0]), _t(cheapest["worst"]) + " (6 nodes on r = R/10⁷, 60–70 working digits)",
+                            f"{ratio_cheapest:.1f}×", "— (shown)"))
     if 16 in worst:
         summary.append(("numeric ω1…ω4 at a new κ (precision=16)", _t(worst[16][0]), _t(floor_numeric) + " (compiled closed form)",
                         f"{worst[16][0] / floor_numeric:.0f}× the closed form", _verdict(worst[16][0] <= 1e-3 and worst[16][1] <= 1e-14)))
@@ -785,7 +789,10 @@ def run(quick: bool = False) -> str:
                  "on a circle r = R/ρ inside the nearest singularity R = min(1, (1 + κ)/(1 − κ)), ⌈D/log10 ρ⌉ nodes (half of them "
                  "by conjugate symmetry) at D + 4·log10 ρ working digits, D = P + 3 + the digits by which the smallest ω_k falls "
                  "below R^−k; ρ = 4 is the radius of the float64 floor and of the issue's audit, ρ = 10⁷ (5–6 nodes, 60–70 digits) "
-                 "the cheapest of ρ = 2.5, 4, 10, 100, 10⁴, 10⁷ (measured 13, 8.4, 5.3, 2.7, 1.5, 1.0 ms at 30 digits): the floor. "
+                 "the cheapest of ρ = 2.5, 4, 10, 100, 10⁴, 10⁷ (measured 13, 8.4, 5.3, 2.7, 1.5, 1.0 ms at 30 digits). The target "
+                 "is judged against the audit's rule (ρ = 4), as the issue states it; the cheapest rule is shown beside it: "
+                 "the engine derives the general hierarchy (any piecewise-polynomial law, its waveforms too) in mpmath "
+                 "element arithmetic, the rule evaluates this one law's closed-form period at six points. "
                  "Each checked against `piecewise_linear_frequency_taylor` at P + 15 digits; that general reference "
                  "(node doubling from 32 until two rules agree) is timed in the last column for comparison only.\n\n"
                  + "\n".join(floor_lines))
@@ -922,6 +929,19 @@ def run(quick: bool = False) -> str:
                  "r_2² − 2² of the second harmonic (which the one-sided springs excite) shrinks like 1/N² "
                  "(2.4e-4 at N = 200, 9.8e-6 at N = 1000): a near 1:2 internal resonance, and the expansion's range in ε "
                  "shrinks with it.")
+
+    # order 3 with the element laws on every mode: shown, not judged (no target; issue 26's rows are order 2)
+    third = [(size, _median_of("nnm", {"size": size, "mode": 1, "laws": True, "order": 3}, 1, 900))
+             for size in ([20] if quick else [20, 40, 80])]
+    raw["nnm_order_3"] = [{"size": size, "result": result} for size, result in third]
+    fit_third = _power_fit([size for size, _ in third], [result.get("seconds") for _, result in third]) if len(third) > 2 else None
+    parts.append("**Order 3, the same chain with every mode** (`order=3`; shown, not judged): the order-3 forcing of an "
+                 "element holds the products of its order-1 deformations, whose O(N) frequencies r_k make O(N²) combination "
+                 "tones r_k ± r_l, each solved for every component: "
+                 + ", ".join(f"{size} dof {_t(result.get('seconds'))}" if result["status"] == "ok" else f"{size} dof {result['status']}"
+                             for size, result in third)
+                 + (f" (growth N^{fit_third:.2f} over 20…80)" if fit_third is not None else "") + "; the reduced model is the route "
+                 "beyond tens of dof.")
 
     continuation = _call("continuation", {"size": 20, "mode": 1, "start": 0.0, "stop": 0.3, "modal_amplitude": 1.0,
                                           "max_points": 200}, 900)
