@@ -224,13 +224,6 @@ class LindstedtPoincare:
                 # Exact: the normal form does not depend on the order; it is built only on a miss
                 # (its domain has fresh Dummy generators and must not enter the key).
                 key, make_form = (problem_key, "piecewise", None), lambda: contact_normal_form(problem, None)
-            elif not contact_law:
-                # Polynomial pieces in floats: derived afresh (~1.4 ms to order 4, 36 ms to order 20), not kept.
-                # Kept, a sweep over a parameter turns the cache over at every value, and the evicted hierarchies
-                # (~1000 objects each) outlive the young generations: measured over 600 new κ at 16 and 30
-                # digits (two runs each), median unchanged (~1.5 ms), 99th percentile 6.5–15 → 1.7–2.9 ms.
-                form = contact_normal_form(problem, self.precision, order_hint=order + 1)
-                return form, BranchHierarchy(form.system, problem.normalization)
             else:
                 # Float: the working digits (precision + guard digits near grazing, which grow with
                 # the order) decide the hierarchy; the float normal form is cheap, build it to know them.
@@ -241,6 +234,12 @@ class LindstedtPoincare:
                 built = make_form()
                 return built, BranchHierarchy(built.system, problem.normalization)
 
+            if self.numeric and not contact_law:
+                # Polynomial pieces in floats: derived afresh (~1.4 ms to order 4, 36 ms to order 20), not kept.
+                # Kept, a sweep over a parameter turns the cache over at every value, and the evicted hierarchies
+                # (~1000 objects each) outlive the young generations: measured over 600 new κ at 16 and 30
+                # digits (two runs each), median unchanged (~1.5 ms), 99th percentile 6.5–15 → 1.7–2.9 ms.
+                return build()
             return _CACHE.get(key, build)
         digits = None if problem.is_polynomial else self.precision
 
